@@ -1,0 +1,121 @@
+//! The dataset-level `manifest.json`: what generated the dataset and, per scene, every file
+//! with its checksum, so that resumed or sharded runs can tell finished scenes from broken ones.
+
+use std::collections::BTreeMap;
+use std::ffi::OsString;
+use std::fs::File;
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+
+use crate::error::{Error, Result};
+
+/// One file of a scene.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FileEntry {
+    /// Relative to the dataset root, `/`-separated on every platform.
+    pub path: String,
+    /// Lowercase hex SHA-256 of the contents.
+    pub sha256: String,
+    /// Size in bytes (checked first: cheaper than hashing).
+    pub bytes: u64,
+}
+
+/// One scene of the dataset.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SceneEntry {
+    /// Scene index in the whole dataset (the split is a function of it).
+    pub index: u64,
+    /// Split name (`train`, `val`, …).
+    pub split: String,
+    /// Scene folder relative to the dataset root, `/`-separated.
+    pub dir: String,
+    /// Every file of the scene.
+    pub files: Vec<FileEntry>,
+}
+
+/// Contents of `manifest.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    /// Name of the generating program.
+    pub generator: String,
+    /// Its version.
+    pub version: String,
+    /// Hash of the configuration, to refuse resuming with a different one.
+    pub config_hash: String,
+    /// Dataset seed.
+    pub seed: u64,
+    /// The full configuration.
+    pub config: serde_json::Value,
+    /// Split name → number of scenes.
+    pub splits: BTreeMap<String, u64>,
+    /// The scenes written so far.
+    pub scenes: Vec<SceneEntry>,
+}
+
+impl Manifest {
+    /// Reads and parses `path`.
+    pub fn read(path: &Path) -> Result<Self> {
+        let text = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        serde_json::from_slice(&text).map_err(|e| Error::format(path, e.to_string()))
+    }
+
+    /// Writes pretty JSON atomically: to `<path>.tmp`, synced, then renamed over `path`, so
+    /// an interrupted run never leaves a truncated manifest behind.
+    pub fn write(&self, path: &Path) -> Result<()> {
+        let mut text = serde_json::to_string_pretty(self).expect("a Manifest always serialises");
+        text.push('\n');
+        let tmp = tmp_path(path);
+        let written = File::create(&tmp).and_then(|mut file| {
+            file.write_all(text.as_bytes())?;
+            file.sync_all()
+        });
+        written.map_err(|e| Error::io(&tmp, e))?;
+        std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e))
+    }
+}
+
+/// `path` with `.tmp` appended to its full file name (`manifest.json.tmp`).
+fn tmp_path(path: &Path) -> PathBuf {
+    let mut name = OsString::from(path.as_os_str());
+    name.push(".tmp");
+    name.into()
+}
+
+/// Lowercase hex SHA-256 and size of the file at `path`, read in chunks so that large
+/// files are not held in memory.
+pub fn sha256_file(path: &Path) -> Result<(String, u64)> {
+    let io = |e| Error::io(path, e);
+    let mut file = File::open(path).map_err(io)?;
+    let mut hasher = Sha256::new();
+    let mut buffer = vec![0u8; 1 << 16];
+    let mut bytes = 0u64;
+    loop {
+        let n = file.read(&mut buffer).map_err(io)?;
+        if n == 0 {
+            break;
+        }
+        hasher.update(&buffer[..n]);
+        bytes += n as u64;
+    }
+    let hex = hasher
+        .finalize()
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    Ok((hex, bytes))
+}
+
+/// Whether every file of `e` exists under `root` with the recorded size and hash.
+///
+/// Any error (missing file, unreadable file) means "does not verify": the caller's remedy
+/// is the same, re-generating the scene.
+pub fn scene_entry_verifies(root: &Path, e: &SceneEntry) -> bool {
+    e.files.iter().all(|f| {
+        let path = root.join(&f.path);
+        let size_matches = std::fs::metadata(&path).is_ok_and(|m| m.len() == f.bytes);
+        size_matches && sha256_file(&path).is_ok_and(|(hex, _)| hex.eq_ignore_ascii_case(&f.sha256))
+    })
+}

@@ -1,0 +1,320 @@
+//! Generator configuration: `generator.toml`, presets and `--set` overrides.
+//!
+//! Defaults live in exactly one place, the `Default` impls below; `generator.toml` documents them
+//! and a test keeps the two identical. Overrides are applied to the TOML tree *before*
+//! deserialising, so a `--set` key goes through the same validation as a key in the file, and
+//! unknown keys are rejected by name instead of being silently ignored.
+
+use anyhow::{Context, Result, bail};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// The whole configuration of one dataset.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Config {
+    pub dataset: DatasetConfig,
+    pub camera: CameraConfig,
+    pub render: RenderConfig,
+    pub scene: SceneConfig,
+}
+
+/// What is generated and where it goes.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DatasetConfig {
+    /// Number of scenes when `--scenes` is not given.
+    pub scenes: u64,
+    /// Master seed; every random choice derives from (seed, scene index, view, pixel).
+    pub seed: u64,
+    /// Scene `i` goes to `val` when `i % val_every == val_every - 1`, else to `train`
+    /// (110 scenes give the thesis' 100/10 split). 0 puts every scene in `train`.
+    pub val_every: u64,
+    /// Default output folder.
+    pub out: String,
+    /// `date` written into parameters.cfg; empty means the day the run starts (set it to make
+    /// datasets byte-identical across days).
+    pub date: String,
+}
+
+impl Default for DatasetConfig {
+    fn default() -> Self {
+        Self { scenes: 110, seed: 0, val_every: 11, out: "datasets/lfgen".into(), date: String::new() }
+    }
+}
+
+/// How baseline and focus distance are chosen.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BaselineMode {
+    /// Solved per scene so the visible depth range maps onto `disparity_range`.
+    Auto,
+    /// `baseline_mm` and `focus_distance_m` as given.
+    Fixed,
+}
+
+/// The light-field camera grid (HCI conventions, SPEC §2).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CameraConfig {
+    /// Image size in pixels, `[width, height]`.
+    pub resolution: [u32; 2],
+    /// Number of cameras, `[num_cams_x, num_cams_y]`; both odd.
+    pub grid: [u32; 2],
+    pub focal_length_mm: f64,
+    /// The larger sensor side, as in HCI.
+    pub sensor_size_mm: f64,
+    pub baseline: BaselineMode,
+    /// Used when `baseline = "fixed"`.
+    pub baseline_mm: f64,
+    /// Used when `baseline = "fixed"`.
+    pub focus_distance_m: f64,
+    /// Target disparity range `[d_min, d_max]` in pixels for `baseline = "auto"`.
+    pub disparity_range: [f64; 2],
+}
+
+impl Default for CameraConfig {
+    fn default() -> Self {
+        Self {
+            resolution: [512, 512],
+            grid: [9, 9],
+            focal_length_mm: 100.0,
+            sensor_size_mm: 35.0,
+            baseline: BaselineMode::Auto,
+            baseline_mm: 50.0,
+            focus_distance_m: 3.0,
+            disparity_range: [-3.5, 3.5],
+        }
+    }
+}
+
+/// Which views get multimodal ground truth.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum GtViews {
+    Center,
+    All,
+}
+
+/// How the depth range is cut into slices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SliceSpacing {
+    /// Equal depth (the thesis' choice).
+    Depth,
+    /// Equal disparity (equal 1/Z).
+    Disparity,
+}
+
+/// Path tracer and ground-truth settings.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RenderConfig {
+    /// Samples per pixel (stratified over the pixel, box filter).
+    pub spp: u32,
+    /// Maximum number of path vertices after the camera.
+    pub max_depth: u32,
+    /// Russian roulette starts after this many bounces.
+    pub rr_depth: u32,
+    pub gt_views: GtViews,
+    /// Number of depth slices S.
+    pub slices: u32,
+    pub slice_spacing: SliceSpacing,
+    /// A slice is a mode when its η (or η_exact) exceeds this.
+    pub mode_epsilon: f64,
+    /// Shade every slice and write `slices.exr` (centre view); costs a shading per hit.
+    pub write_slices: bool,
+    /// Also write linear `input_CamNNN.exr`.
+    pub write_exr: bool,
+    /// Choose the exposure per scene from the centre view (key 0.18 on the log-average).
+    pub auto_exposure: bool,
+    /// Multiplier applied on top of (auto) exposure.
+    pub exposure: f64,
+}
+
+impl Default for RenderConfig {
+    fn default() -> Self {
+        Self {
+            spp: 16,
+            max_depth: 5,
+            rr_depth: 3,
+            gt_views: GtViews::Center,
+            slices: 128,
+            slice_spacing: SliceSpacing::Depth,
+            mode_epsilon: 1e-4,
+            write_slices: false,
+            write_exr: false,
+            auto_exposure: true,
+            exposure: 1.0,
+        }
+    }
+}
+
+/// The built-in procedural scene generator.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SceneConfig {
+    /// Room width range (x, metres).
+    pub room_width: [f64; 2],
+    /// Room depth range (along the view, metres).
+    pub room_depth: [f64; 2],
+    /// Room height range (metres).
+    pub room_height: [f64; 2],
+    /// Number of objects placed in the room.
+    pub objects: u32,
+    /// Probability that an object's material is semi-transparent (opacity in `opacity_range`).
+    pub semi_transparent: f64,
+    pub opacity_range: [f64; 2],
+    /// Probability of a glass (dielectric) object.
+    pub glass: f64,
+    /// Probability of a grid / woven cut-out (alpha texture) panel.
+    pub cutout: f64,
+    /// Number of ceiling area lights.
+    pub lights: u32,
+    /// Radiance of the environment seen through openings (linear RGB).
+    pub environment: [f64; 3],
+}
+
+impl Default for SceneConfig {
+    fn default() -> Self {
+        Self {
+            room_width: [4.0, 7.0],
+            room_depth: [7.0, 12.0],
+            room_height: [2.6, 3.4],
+            objects: 48,
+            semi_transparent: 0.25,
+            opacity_range: [0.2, 0.8],
+            glass: 0.1,
+            cutout: 0.15,
+            lights: 3,
+            environment: [0.2, 0.22, 0.25],
+        }
+    }
+}
+
+/// Named bundles of overrides, applied before the user's `--set`s.
+pub const PRESETS: &[(&str, &[&str])] = &[
+    ("full", &[]),
+    ("quick", &["camera.resolution=[128,128]", "render.spp=8"]),
+    ("wide", &["camera.disparity_range=[-40.0,40.0]"]),
+];
+
+impl Config {
+    /// Loads `path` (or the built-in defaults when `None`), then applies presets and overrides.
+    pub fn load(path: Option<&Path>, presets: &[String], sets: &[String]) -> Result<Self> {
+        let mut table = match path {
+            Some(p) => {
+                let text = std::fs::read_to_string(p)
+                    .with_context(|| format!("cannot read config {}", p.display()))?;
+                toml::from_str::<toml::Table>(&text)
+                    .with_context(|| format!("{}: malformed TOML", p.display()))?
+            }
+            None => toml::Table::new(),
+        };
+        for name in presets {
+            let (_, sets) = PRESETS
+                .iter()
+                .find(|(n, _)| n == name)
+                .with_context(|| format!("unknown preset {name:?} (known: full, quick, wide)"))?;
+            for s in *sets {
+                apply_set(&mut table, s)?;
+            }
+        }
+        for s in sets {
+            apply_set(&mut table, s)?;
+        }
+        let origin = path.map_or("built-in defaults".into(), |p| p.display().to_string());
+        let cfg: Config = table.try_into().with_context(|| format!("{origin}: invalid config"))?;
+        cfg.validate().with_context(|| format!("{origin}: invalid config"))?;
+        Ok(cfg)
+    }
+
+    /// Semantic checks that serde cannot express.
+    pub fn validate(&self) -> Result<()> {
+        let c = &self.camera;
+        if c.grid.iter().any(|&n| n == 0 || n % 2 == 0) {
+            bail!("camera.grid must be odd counts (HCI), got {:?}", c.grid);
+        }
+        if c.resolution.iter().any(|&n| n == 0 || n > 16384) {
+            bail!("camera.resolution out of range: {:?}", c.resolution);
+        }
+        if !(c.disparity_range[0] < c.disparity_range[1]) {
+            bail!("camera.disparity_range must be increasing, got {:?}", c.disparity_range);
+        }
+        let positive = [c.focal_length_mm, c.sensor_size_mm, c.baseline_mm, c.focus_distance_m];
+        if positive.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
+            bail!("camera focal length, sensor size, baseline and focus must be positive");
+        }
+        let r = &self.render;
+        if r.spp == 0 || r.slices == 0 || r.max_depth == 0 {
+            bail!("render.spp, render.slices and render.max_depth must be at least 1");
+        }
+        if !(0.0..1.0).contains(&r.mode_epsilon) || !(r.exposure > 0.0) {
+            bail!("render.mode_epsilon must be in [0, 1) and render.exposure positive");
+        }
+        self.scene.validate()
+    }
+
+    /// SHA-256 of the canonical JSON form: identifies the config in the manifest.
+    pub fn hash(&self) -> String {
+        let json = serde_json::to_vec(self).expect("config serialises");
+        crate::output::hex_sha256(&json)
+    }
+}
+
+impl SceneConfig {
+    fn validate(&self) -> Result<()> {
+        let ranges = [self.room_width, self.room_depth, self.room_height, self.opacity_range];
+        if ranges.iter().any(|[a, b]| !(a.is_finite() && *a > 0.0 && a <= b)) {
+            bail!("scene ranges must be positive [min, max] pairs");
+        }
+        let probs = [self.semi_transparent, self.glass, self.cutout];
+        if probs.iter().any(|p| !(0.0..=1.0).contains(p)) || self.opacity_range[1] > 1.0 {
+            bail!("scene probabilities and opacities must lie in [0, 1]");
+        }
+        Ok(())
+    }
+}
+
+/// Applies one `section.key=value` override. The value is parsed as TOML (`[64,64]`, `4`,
+/// `true`, `"x"`); a bare word that is not TOML is taken as a string (`render.gt_views=all`).
+fn apply_set(table: &mut toml::Table, set: &str) -> Result<()> {
+    let (key, raw) = set
+        .split_once('=')
+        .with_context(|| format!("--set {set:?}: expected section.key=value"))?;
+    let path: Vec<&str> = key.trim().split('.').collect();
+    check_known_key(&path).with_context(|| format!("--set {set:?}"))?;
+    let raw = raw.trim();
+    let value = toml::from_str::<toml::Table>(&format!("v = {raw}"))
+        .ok()
+        .and_then(|mut t| t.remove("v"))
+        .unwrap_or_else(|| toml::Value::String(raw.to_string()));
+    let (last, parents) = path.split_last().expect("non-empty path");
+    let mut node = table;
+    for p in parents {
+        node = node
+            .entry(p.to_string())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()))
+            .as_table_mut()
+            .with_context(|| format!("--set {set:?}: {p} is not a section"))?;
+    }
+    node.insert(last.to_string(), value);
+    Ok(())
+}
+
+/// Rejects keys that the config does not have, listing the valid ones of that section.
+fn check_known_key(path: &[&str]) -> Result<()> {
+    let defaults = toml::Table::try_from(Config::default()).expect("defaults serialise");
+    let mut node = &defaults;
+    for (i, p) in path.iter().enumerate() {
+        match node.get(*p) {
+            Some(toml::Value::Table(t)) if i + 1 < path.len() => node = t,
+            Some(v) if i + 1 == path.len() && !v.is_table() => return Ok(()),
+            _ => {
+                let known: Vec<&String> = node.keys().collect();
+                bail!("unknown config key {:?} (known here: {known:?})", path.join("."));
+            }
+        }
+    }
+    bail!("{:?} is a section, not a key", path.join("."))
+}

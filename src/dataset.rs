@@ -1,0 +1,218 @@
+//! Many scenes: splits, shards, resume, the manifest and progress.
+//!
+//! A scene's split and folder are pure functions of its index and the config, so shards and
+//! resumed runs agree on where every scene goes. After each published scene the manifest is
+//! rewritten atomically, so a killed run loses at most the scene in flight.
+
+use crate::config::Config;
+use crate::pipeline::{RenderJob, generate_scene, render_scene};
+use anyhow::{Context, Result, bail};
+use indicatif::{ProgressBar, ProgressStyle};
+use lfformat::manifest::{Manifest, SceneEntry, scene_entry_verifies};
+use std::collections::BTreeMap;
+use std::fs;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
+
+/// What to generate and where.
+#[derive(Clone, Debug)]
+pub struct GenerateOptions {
+    pub scenes: u64,
+    pub out: PathBuf,
+    /// `(i, n)`: render scenes with `index % n == i`.
+    pub shard: (u64, u64),
+    pub resume: bool,
+    pub quiet: bool,
+}
+
+/// Split of scene `index` (see `dataset.val_every`).
+pub fn split_of(cfg: &Config, index: u64) -> &'static str {
+    let every = cfg.dataset.val_every;
+    if every > 0 && index % every == every - 1 { "val" } else { "train" }
+}
+
+/// Folder of scene `index`, relative to the dataset root.
+pub fn scene_dir(cfg: &Config, index: u64) -> String {
+    format!("{}/scene_{index:04}", split_of(cfg, index))
+}
+
+fn manifest_name((i, n): (u64, u64)) -> String {
+    if n > 1 { format!("manifest.shard-{i}-of-{n}.json") } else { "manifest.json".into() }
+}
+
+/// Generates the dataset (or this shard of it).
+pub fn generate(cfg: &Config, opts: &GenerateOptions) -> Result<()> {
+    check_writable(&opts.out)?;
+    let manifest_path = opts.out.join(manifest_name(opts.shard));
+    let mut manifest = open_manifest(cfg, opts, &manifest_path)?;
+    let todo: Vec<u64> = (0..opts.scenes).filter(|i| i % opts.shard.1 == opts.shard.0).collect();
+    let date = if cfg.dataset.date.is_empty() { today() } else { cfg.dataset.date.clone() };
+    let job = RenderJob::from_config(cfg, &date);
+    let [w, h] = cfg.camera.resolution;
+    let per_scene = w as u64 * h as u64 * cfg.render.spp as u64 * (cfg.camera.grid[0] * cfg.camera.grid[1]) as u64;
+    let bar = progress_bar(todo.len() as u64 * per_scene, opts.quiet);
+    let samples = AtomicU64::new(0);
+    let (mut done, mut skipped) = (0, 0);
+    for index in todo {
+        let dir = scene_dir(cfg, index);
+        if opts.resume && manifest.scenes.iter().any(|e| e.index == index && scene_entry_verifies(&opts.out, e)) {
+            skipped += 1;
+            samples.fetch_add(per_scene, Ordering::Relaxed);
+            continue;
+        }
+        let started = Instant::now();
+        let (mut desc, scene) = generate_scene(cfg, index).with_context(|| format!("scene {index}"))?;
+        let before = samples.load(Ordering::Relaxed);
+        let files = std::thread::scope(|s| {
+            let ticker = s.spawn(|| tick(&bar, &samples, before + per_scene));
+            let r = render_scene(&mut desc, &scene, &job, &opts.out.join(&dir), &opts.out, &samples);
+            samples.store(before + per_scene, Ordering::Relaxed);
+            ticker.join().expect("progress thread");
+            r
+        })
+        .with_context(|| format!("scene {index} ({dir})"))?;
+        manifest.scenes.retain(|e| e.index != index);
+        manifest.scenes.push(SceneEntry { index, split: split_of(cfg, index).into(), dir: dir.clone(), files });
+        manifest.scenes.sort_by_key(|e| e.index);
+        manifest.splits = count_splits(&manifest.scenes);
+        manifest.write(&manifest_path)?;
+        log_timing(&opts.out, index, started.elapsed().as_secs_f64(), per_scene)?;
+        done += 1;
+        bar.set_message(format!("{done} scenes rendered, {skipped} verified"));
+    }
+    bar.finish_with_message(format!("{done} scenes rendered, {skipped} verified and kept"));
+    if opts.shard.1 == 1 {
+        write_readme(&opts.out, &manifest)?;
+    }
+    Ok(())
+}
+
+/// Keeps the progress bar moving while a scene renders; stops when `end` samples are done.
+fn tick(bar: &ProgressBar, samples: &AtomicU64, end: u64) {
+    loop {
+        let n = samples.load(Ordering::Relaxed);
+        bar.set_position(n);
+        if n >= end {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(200));
+    }
+}
+
+fn progress_bar(total: u64, quiet: bool) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(total);
+    let style = "{elapsed_precise} [{bar:30}] {percent}% {human_pos}/{human_len} camera rays, {per_sec}, ETA {eta} — {msg}";
+    bar.set_style(ProgressStyle::with_template(style).expect("valid template").progress_chars("=> "));
+    bar
+}
+
+/// The existing manifest when resuming (same config only), else a fresh one.
+fn open_manifest(cfg: &Config, opts: &GenerateOptions, path: &Path) -> Result<Manifest> {
+    let fresh = Manifest {
+        generator: "lfgen".into(),
+        version: env!("CARGO_PKG_VERSION").into(),
+        config_hash: cfg.hash(),
+        seed: cfg.dataset.seed,
+        config: serde_json::to_value(cfg)?,
+        splits: BTreeMap::new(),
+        scenes: Vec::new(),
+    };
+    if !path.exists() {
+        return Ok(fresh);
+    }
+    let old = Manifest::read(path)?;
+    if !opts.resume && !old.scenes.is_empty() {
+        bail!(
+            "{} already holds a dataset ({} scenes): pass --resume to complete it, or choose another --out",
+            opts.out.display(),
+            old.scenes.len()
+        );
+    }
+    if old.config_hash != fresh.config_hash {
+        bail!("{}: the dataset was generated with a different config; resume needs the same config", path.display());
+    }
+    Ok(Manifest { scenes: old.scenes, ..fresh })
+}
+
+fn count_splits(scenes: &[SceneEntry]) -> BTreeMap<String, u64> {
+    let mut m = BTreeMap::new();
+    for e in scenes {
+        *m.entry(e.split.clone()).or_insert(0) += 1;
+    }
+    m
+}
+
+/// Fails early, naming the folder, when the output cannot be written.
+fn check_writable(out: &Path) -> Result<()> {
+    fs::create_dir_all(out).with_context(|| format!("cannot create output folder {}", out.display()))?;
+    let probe = out.join(".lfgen-write-test");
+    fs::write(&probe, b"ok").with_context(|| format!("output folder {} is not writable", out.display()))?;
+    fs::remove_file(&probe).with_context(|| format!("output folder {} is not writable", out.display()))
+}
+
+/// Render timings live outside the scene folders so those stay byte-reproducible.
+fn log_timing(out: &Path, index: u64, seconds: f64, samples: u64) -> Result<()> {
+    let path = out.join("timings.jsonl");
+    let line = serde_json::json!({ "scene": index, "seconds": seconds, "camera_rays_per_second": samples as f64 / seconds });
+    let mut f = fs::OpenOptions::new().create(true).append(true).open(&path).with_context(|| format!("cannot write {}", path.display()))?;
+    writeln!(f, "{line}").with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Unions `manifest.json` and every `manifest.shard-*.json` of `out` into `manifest.json`,
+/// keeping only scenes whose files verify.
+pub fn merge(out: &Path) -> Result<Manifest> {
+    let mut parts = Vec::new();
+    for entry in fs::read_dir(out).with_context(|| format!("cannot list {}", out.display()))? {
+        let name = entry?.file_name().to_string_lossy().into_owned();
+        if name == "manifest.json" || (name.starts_with("manifest.shard-") && name.ends_with(".json")) {
+            parts.push(Manifest::read(&out.join(&name))?);
+        }
+    }
+    let mut merged = parts.first().cloned().with_context(|| format!("{}: no manifest to merge", out.display()))?;
+    let mut scenes = BTreeMap::new();
+    for p in &parts {
+        if p.config_hash != merged.config_hash {
+            bail!("{}: shards were generated with different configs", out.display());
+        }
+        for e in &p.scenes {
+            if scene_entry_verifies(out, e) {
+                scenes.insert(e.index, e.clone());
+            }
+        }
+    }
+    merged.scenes = scenes.into_values().collect();
+    merged.splits = count_splits(&merged.scenes);
+    merged.write(&out.join("manifest.json"))?;
+    write_readme(out, &merged)?;
+    Ok(merged)
+}
+
+/// A short human-readable description at the dataset root.
+fn write_readme(out: &Path, m: &Manifest) -> Result<()> {
+    let splits: Vec<String> = m.splits.iter().map(|(k, v)| format!("{v} {k}")).collect();
+    let text = format!(
+        "# lfgen dataset\n\nGenerated by {} {} with seed {} (config hash `{}`).\n\n\
+         Scenes: {} ({}). Each scene folder is an HCI 4D light-field benchmark scene \
+         (`parameters.cfg`, `input_CamNNN.png`, `gt_disp_lowres.pfm`, `gt_depth_lowres.pfm`) plus \
+         multimodal ground truth (`modes.exr`, `gt_mpi_lowres.npz`), `scene.json` and `stats.json`.\n\
+         `manifest.json` lists every file with its SHA-256.\n",
+        m.generator,
+        m.version,
+        m.seed,
+        m.config_hash,
+        m.scenes.len(),
+        splits.join(", ")
+    );
+    let path = out.join("README.md");
+    fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Today's date (UTC) as `YYYY-MM-DD`.
+fn today() -> String {
+    humantime::format_rfc3339(std::time::SystemTime::now()).to_string()[..10].to_string()
+}

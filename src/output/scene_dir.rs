@@ -1,0 +1,155 @@
+//! One scene folder (SPEC §4), written atomically: into `.NAME.partial`, then renamed.
+
+use super::images::{write_linear_exr, write_png};
+use crate::camera::LightFieldCamera;
+use crate::scene::SceneDesc;
+use crate::stats::SceneStats;
+use anyhow::{Context, Result};
+use glam::Vec3;
+use lfformat::manifest::{FileEntry, sha256_file};
+use lfformat::modes::write_modes_exr;
+use lfformat::mpi::{Mpi, write_mpi_npz};
+use lfformat::params::hci_disp_bounds;
+use lfformat::pfm::{FloatImage, write_pfm};
+use lfformat::{HciParameters, ModeMap};
+use std::fs;
+use std::path::{Path, PathBuf};
+
+/// Writes the files of one scene into a temporary folder and publishes it on [`Self::finish`].
+pub struct SceneWriter {
+    final_dir: PathBuf,
+    tmp_dir: PathBuf,
+    write_exr: bool,
+}
+
+/// Ground truth of one view, as the writer needs it.
+pub struct GtImages<'a> {
+    pub modes: &'a ModeMap,
+    /// Linear colour per mode, in `modes` storage order.
+    pub colors: &'a [[f32; 3]],
+    /// HCI single-valued planar depth per pixel (NaN: none).
+    pub hci_depth: &'a [f32],
+}
+
+impl SceneWriter {
+    /// Starts a scene that will end up at `final_dir` (a stale partial folder is removed).
+    pub fn create(final_dir: &Path, write_exr: bool) -> Result<Self> {
+        let name = final_dir.file_name().context("scene folder has no name")?.to_string_lossy();
+        let tmp_dir = final_dir.with_file_name(format!(".{name}.partial"));
+        if tmp_dir.exists() {
+            fs::remove_dir_all(&tmp_dir).with_context(|| format!("cannot remove stale {}", tmp_dir.display()))?;
+        }
+        fs::create_dir_all(&tmp_dir).with_context(|| format!("cannot create {}", tmp_dir.display()))?;
+        Ok(Self { final_dir: final_dir.to_path_buf(), tmp_dir, write_exr })
+    }
+
+    fn path(&self, name: &str) -> PathBuf {
+        self.tmp_dir.join(name)
+    }
+
+    /// `input_CamNNN.png` (and `.exr` when enabled).
+    pub fn write_view(&self, view: u32, width: usize, height: usize, pixels: &[Vec3], exposure: f32) -> Result<()> {
+        write_png(&self.path(&format!("input_Cam{view:03}.png")), width, height, pixels, exposure)?;
+        if self.write_exr {
+            write_linear_exr(&self.path(&format!("input_Cam{view:03}.exr")), width, height, pixels)?;
+        }
+        Ok(())
+    }
+
+    /// Ground-truth files of a view. The centre view gets HCI's unsuffixed names plus the
+    /// MPI; with per-view GT (`per_view`) every view also gets `_CamNNN` variants.
+    pub fn write_gt(&self, view: u32, is_center: bool, per_view: bool, cam: &LightFieldCamera, gt: &GtImages) -> Result<()> {
+        let (w, h) = (gt.modes.width, gt.modes.height);
+        let depth = FloatImage::new(w, h, gt.hci_depth.to_vec());
+        let disp = FloatImage::new(w, h, gt.hci_depth.iter().map(|&z| cam.disparity(z as f64) as f32).collect());
+        let mut suffixes = Vec::new();
+        if is_center {
+            suffixes.push(String::new());
+            write_mpi_npz(&self.path("gt_mpi_lowres.npz"), &Mpi::from_modes(gt.modes, Some(gt.colors)))?;
+        }
+        if per_view {
+            suffixes.push(format!("_Cam{view:03}"));
+        }
+        for s in &suffixes {
+            write_pfm(&self.path(&format!("gt_depth_lowres{s}.pfm")), &depth)?;
+            write_pfm(&self.path(&format!("gt_disp_lowres{s}.pfm")), &disp)?;
+            write_modes_exr(&self.path(&format!("modes{s}.exr")), gt.modes)?;
+        }
+        Ok(())
+    }
+
+    /// Writes `parameters.cfg`, `scene.json` and `stats.json`, publishes the folder and returns
+    /// its files (paths relative to `root`) with their checksums.
+    pub fn finish(self, desc: &SceneDesc, stats: &SceneStats, root: &Path) -> Result<Vec<FileEntry>> {
+        let params = hci_parameters(desc, stats);
+        params.write(&self.path("parameters.cfg"))?;
+        write_json(&self.path("scene.json"), desc)?;
+        write_json(&self.path("stats.json"), stats)?;
+        if self.final_dir.exists() {
+            fs::remove_dir_all(&self.final_dir)
+                .with_context(|| format!("cannot replace {}", self.final_dir.display()))?;
+        }
+        fs::rename(&self.tmp_dir, &self.final_dir)
+            .with_context(|| format!("cannot rename {} into place", self.tmp_dir.display()))?;
+        list_files(&self.final_dir, root)
+    }
+}
+
+/// Pretty JSON, with the path in any error.
+pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<()> {
+    let text = serde_json::to_string_pretty(value)?;
+    fs::write(path, text + "\n").with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Checksums of every file in `dir`, sorted by name, paths relative to `root`.
+pub fn list_files(dir: &Path, root: &Path) -> Result<Vec<FileEntry>> {
+    let mut names: Vec<PathBuf> = fs::read_dir(dir)
+        .with_context(|| format!("cannot list {}", dir.display()))?
+        .map(|e| e.map(|e| e.path()))
+        .collect::<std::io::Result<_>>()?;
+    names.sort();
+    names
+        .iter()
+        .map(|p| {
+            let (sha256, bytes) = sha256_file(p)?;
+            let rel = p.strip_prefix(root).unwrap_or(p);
+            let path = rel.components().map(|c| c.as_os_str().to_string_lossy()).collect::<Vec<_>>().join("/");
+            Ok(FileEntry { path, sha256, bytes })
+        })
+        .collect()
+}
+
+/// HCI `parameters.cfg` of a scene (SPEC §2, HCI.md).
+fn hci_parameters(desc: &SceneDesc, stats: &SceneStats) -> HciParameters {
+    let cam = &desc.camera;
+    let [px, py, pz] = cam.blender_position();
+    let [rx, ry, rz] = cam.blender_rotation();
+    let (disp_min, disp_max) = hci_disp_bounds(stats.hci_disparity_range[0], stats.hci_disparity_range[1]);
+    HciParameters {
+        focal_length_mm: cam.focal_length_mm,
+        image_resolution_x_px: cam.resolution[0],
+        image_resolution_y_px: cam.resolution[1],
+        sensor_size_mm: cam.sensor_size_mm,
+        fstop: 100.0,
+        num_cams_x: cam.grid[0],
+        num_cams_y: cam.grid[1],
+        baseline_mm: cam.baseline_m * 1000.0,
+        focus_distance_m: cam.focus_distance_m,
+        center_cam_x_m: px,
+        center_cam_y_m: py,
+        center_cam_z_m: pz,
+        center_cam_rx_rad: rx,
+        center_cam_ry_rad: ry,
+        center_cam_rz_rad: rz,
+        scene: desc.name.clone(),
+        category: "lfgen".into(),
+        date: stats.date.clone(),
+        version: desc.generator.clone(),
+        cycles_seed: desc.seed,
+        disp_min,
+        disp_max,
+        frustum_disp_min: cam.disparity(desc.slices.z_far),
+        frustum_disp_max: cam.disparity(desc.slices.z_near),
+        depth_map_scale: 1.0,
+    }
+}

@@ -1,0 +1,126 @@
+//! One scene from description to published folder: build, frame, render every view, write.
+
+use crate::config::{Config, GtViews};
+use crate::output::scene_dir::{GtImages, SceneWriter};
+use crate::render::framing::auto_exposure;
+use crate::render::integrator::PathSettings;
+use crate::render::view::{RenderSettings, ViewOutput};
+use crate::render::RenderScene;
+use crate::scene::{SceneDesc, builtin};
+use crate::stats::SceneStats;
+use anyhow::Result;
+use lfformat::manifest::FileEntry;
+use std::path::Path;
+use std::sync::atomic::AtomicU64;
+
+/// Rendering choices that are not part of the scene itself.
+#[derive(Clone, Debug)]
+pub struct RenderJob {
+    pub spp: u32,
+    pub path: PathSettings,
+    pub gt_views: GtViews,
+    pub mode_epsilon: f32,
+    pub write_exr: bool,
+    /// Choose the exposure from the centre view (else keep the scene's).
+    pub auto_exposure: bool,
+    /// Date written into parameters.cfg.
+    pub date: String,
+}
+
+impl RenderJob {
+    pub fn from_config(cfg: &Config, date: &str) -> Self {
+        let r = &cfg.render;
+        Self {
+            spp: r.spp,
+            path: PathSettings { max_depth: r.max_depth, rr_depth: r.rr_depth },
+            gt_views: r.gt_views,
+            mode_epsilon: r.mode_epsilon as f32,
+            write_exr: r.write_exr,
+            auto_exposure: r.auto_exposure,
+            date: date.to_string(),
+        }
+    }
+}
+
+/// Generates scene `index` of `cfg` and frames its camera: the re-renderable description.
+pub fn generate_scene(cfg: &Config, index: u64) -> Result<(SceneDesc, RenderScene)> {
+    let mut desc = builtin::generate(cfg, index);
+    let scene = RenderScene::build(&desc)?;
+    desc.slices = scene.frame(&mut desc.camera, &cfg.camera, cfg.render.slices, cfg.render.slice_spacing)?;
+    Ok((desc, scene))
+}
+
+/// Renders every view of `desc` into `final_dir` (atomically) and returns the published files.
+/// `samples_done` counts camera samples for progress display.
+pub fn render_scene(
+    desc: &mut SceneDesc,
+    scene: &RenderScene,
+    job: &RenderJob,
+    final_dir: &Path,
+    root: &Path,
+    samples_done: &AtomicU64,
+) -> Result<Vec<FileEntry>> {
+    let writer = SceneWriter::create(final_dir, job.write_exr)?;
+    let settings = RenderSettings {
+        path: job.path,
+        spp: job.spp,
+        seed: desc.seed,
+        scene_index: desc.index,
+        mode_epsilon: job.mode_epsilon,
+    };
+    let center = desc.camera.center_view();
+    let per_view = job.gt_views == GtViews::All;
+    // The centre view first: it fixes the exposure for all views and carries the GT.
+    let mut order: Vec<u32> = vec![center];
+    order.extend((0..desc.camera.num_views()).filter(|&v| v != center));
+    let mut stats = None;
+    for view in order {
+        let with_gt = view == center || per_view;
+        let out = scene.render_view(&desc.camera, &desc.slices, &settings, view, with_gt, samples_done);
+        if view == center && job.auto_exposure {
+            desc.exposure *= auto_exposure(&out.image.pixels);
+        }
+        writer.write_view(view, out.image.width, out.image.height, &out.image.pixels, desc.exposure)?;
+        if let Some(gt) = &out.gt {
+            let images = GtImages { modes: &gt.modes, colors: &gt.colors, hci_depth: &gt.hci_depth };
+            writer.write_gt(view, view == center, per_view, &desc.camera, &images)?;
+        }
+        if view == center {
+            stats = Some(scene_stats(desc, scene, &out, job));
+        }
+    }
+    writer.finish(desc, &stats.expect("centre view rendered"), root)
+}
+
+fn scene_stats(desc: &SceneDesc, scene: &RenderScene, out: &ViewOutput, job: &RenderJob) -> SceneStats {
+    let gt = out.gt.as_ref().expect("centre view has GT");
+    let hci_disp: Vec<f32> = gt.hci_depth.iter().map(|&z| desc.camera.disparity(z as f64) as f32).collect();
+    let mut s = SceneStats::from_gt(&gt.modes, &hci_disp);
+    s.baseline_mm = desc.camera.baseline_m * 1000.0;
+    s.focus_distance_m = desc.camera.focus_distance_m;
+    s.depth_range_m = [desc.slices.z_near, desc.slices.z_far];
+    s.exposure = desc.exposure;
+    s.triangles = scene.geometry.triangle_count() as u64;
+    s.date = job.date.clone();
+    s
+}
+
+/// `lfgen render SCENE.json --out DIR`: renders a saved scene again, with its saved camera,
+/// slices and exposure, and the render settings of `cfg`.
+pub fn rerender(cfg: &Config, scene_json: &Path, out: &Path, quiet: bool) -> Result<()> {
+    use anyhow::Context;
+    let text = std::fs::read_to_string(scene_json).with_context(|| format!("cannot read {}", scene_json.display()))?;
+    let mut desc: SceneDesc =
+        serde_json::from_str(&text).with_context(|| format!("{}: not a valid lfgen scene", scene_json.display()))?;
+    let scene = RenderScene::build(&desc).with_context(|| format!("{}", scene_json.display()))?;
+    let date = cfg.dataset.date.clone();
+    let job = RenderJob { auto_exposure: false, ..RenderJob::from_config(cfg, &date) };
+    let root = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    std::fs::create_dir_all(root).with_context(|| format!("cannot create {}", root.display()))?;
+    let samples = AtomicU64::new(0);
+    render_scene(&mut desc, &scene, &job, out, root, &samples)?;
+    if !quiet {
+        eprintln!("{}: {} camera rays, written to {}", desc.name, samples.into_inner(), out.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,228 @@
+//! Triangles in an obvhs CWBVH and the three ray queries the renderer needs: closest hit with
+//! stochastic transparency, every hit along a ray (for the depth slices), and shadow
+//! transmittance.
+
+use super::material::RenderMaterial;
+use super::sampler::{mix64, unit_float};
+use crate::scene::shapes::MeshTri;
+use anyhow::{Result, bail};
+use glam::{Vec2, Vec3, Vec3A};
+use obvhs::{
+    BvhBuildParams, cwbvh::CwBvh, cwbvh::builder::build_cwbvh_from_tris, ray::Ray,
+    ray::RayHit, triangle::Triangle,
+};
+use std::time::Duration;
+
+/// Intersection data of one triangle, in BVH leaf order.
+#[derive(Clone, Copy)]
+struct IsectTri {
+    v0: Vec3A,
+    e1: Vec3A,
+    e2: Vec3A,
+}
+
+/// Shading data of one triangle, in BVH leaf order.
+#[derive(Clone, Copy, Debug)]
+pub struct TriShading {
+    pub n: [Vec3; 3],
+    pub uv: [Vec2; 3],
+    pub material: u32,
+    pub object: u32,
+    /// Index of the triangle before BVH reordering (spatial splits can duplicate leaves).
+    pub id: u32,
+}
+
+/// A ray–triangle intersection: distance and barycentrics of `v1`, `v2`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    pub t: f32,
+    pub tri: u32,
+    pub b: Vec2,
+}
+
+/// A triangle with its object and material, as handed to [`Geometry::build`].
+pub struct SceneTri {
+    pub tri: MeshTri,
+    pub material: u32,
+    pub object: u32,
+}
+
+/// The scene's triangles and their BVH.
+pub struct Geometry {
+    bvh: CwBvh,
+    isect: Vec<IsectTri>,
+    pub shading: Vec<TriShading>,
+}
+
+impl Geometry {
+    /// Builds the BVH; rejects non-finite vertices, naming the object.
+    pub fn build(tris: &[SceneTri], object_names: &[String]) -> Result<Self> {
+        if let Some(bad) = tris.iter().find(|t| !t.tri.p.iter().all(|p| p.is_finite())) {
+            bail!("object {:?} has non-finite vertex coordinates", object_names[bad.object as usize]);
+        }
+        if tris.is_empty() {
+            bail!("the scene has no geometry");
+        }
+        let prims: Vec<Triangle> = tris
+            .iter()
+            .map(|t| {
+                let [v0, v1, v2] = t.tri.p.map(Vec3A::from);
+                Triangle { v0, v1, v2 }
+            })
+            .collect();
+        let bvh = build_cwbvh_from_tris(&prims, BvhBuildParams::medium_build(), &mut Duration::default());
+        let order = bvh.primitive_indices.iter().map(|&i| i as usize);
+        let isect = order
+            .clone()
+            .map(|i| IsectTri { v0: prims[i].v0, e1: prims[i].v1 - prims[i].v0, e2: prims[i].v2 - prims[i].v0 })
+            .collect();
+        let shading = order
+            .map(|i| {
+                let t = &tris[i];
+                TriShading { n: t.tri.n, uv: t.tri.uv, material: t.material, object: t.object, id: i as u32 }
+            })
+            .collect();
+        Ok(Self { bvh, isect, shading })
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.isect.len()
+    }
+
+    /// Möller–Trumbore; returns `t` in `(tmin, tmax]` or `INFINITY`, and the barycentrics.
+    #[inline(always)]
+    fn intersect(&self, ray: &Ray, leaf: usize) -> (f32, Vec2) {
+        let tri = &self.isect[leaf];
+        let p = ray.direction.cross(tri.e2);
+        let det = tri.e1.dot(p);
+        if det.abs() < 1e-12 {
+            return (f32::INFINITY, Vec2::ZERO);
+        }
+        let inv = 1.0 / det;
+        let s = ray.origin - tri.v0;
+        let u = s.dot(p) * inv;
+        let q = s.cross(tri.e1);
+        let v = ray.direction.dot(q) * inv;
+        let t = tri.e2.dot(q) * inv;
+        if u < 0.0 || v < 0.0 || u + v > 1.0 || !(t > ray.tmin && t <= ray.tmax) {
+            return (f32::INFINITY, Vec2::ZERO);
+        }
+        (t, Vec2::new(u, v))
+    }
+
+    /// Interpolated UV of a hit.
+    #[inline]
+    pub fn uv(&self, hit: &Hit) -> Vec2 {
+        let s = &self.shading[hit.tri as usize];
+        s.uv[0] * (1.0 - hit.b.x - hit.b.y) + s.uv[1] * hit.b.x + s.uv[2] * hit.b.y
+    }
+
+    /// Geometric (winding) normal, unit length.
+    #[inline]
+    pub fn geometric_normal(&self, tri: u32) -> Vec3 {
+        let t = &self.isect[tri as usize];
+        Vec3::from(t.e1.cross(t.e2)).normalize()
+    }
+
+    /// Interpolated shading normal.
+    #[inline]
+    pub fn shading_normal(&self, hit: &Hit) -> Vec3 {
+        let s = &self.shading[hit.tri as usize];
+        let n = s.n[0] * (1.0 - hit.b.x - hit.b.y) + s.n[1] * hit.b.x + s.n[2] * hit.b.y;
+        n.try_normalize().unwrap_or_else(|| self.geometric_normal(hit.tri))
+    }
+
+    /// Area and vertices of a triangle (light sampling).
+    pub fn vertices(&self, tri: u32) -> [Vec3; 3] {
+        let t = &self.isect[tri as usize];
+        [t.v0, t.v0 + t.e1, t.v0 + t.e2].map(Vec3::from)
+    }
+
+    /// Opacity of the surface at a hit (cut-outs and semi-transparency).
+    #[inline]
+    fn opacity(&self, mats: &[RenderMaterial], hit: &Hit) -> f32 {
+        let m = &mats[self.shading[hit.tri as usize].material as usize];
+        m.uniform_opacity.unwrap_or_else(|| m.opacity.eval(self.uv(hit)))
+    }
+
+    /// Whether the stochastic-transparency test keeps this hit. The decision hashes the ray's
+    /// `key` with the triangle, so the same ray sees the same surfaces whichever query asks.
+    #[inline]
+    pub fn accepts(&self, mats: &[RenderMaterial], hit: &Hit, key: u64) -> bool {
+        let a = self.opacity(mats, hit);
+        a >= 1.0 || (a > 0.0 && unit_float(mix64(key ^ self.shading[hit.tri as usize].id as u64)) < a)
+    }
+
+    /// Closest hit that passes the stochastic-transparency test for `key`.
+    pub fn closest(&self, mats: &[RenderMaterial], origin: Vec3, dir: Vec3, tmax: f32, key: u64) -> Option<Hit> {
+        let ray = Ray::new(origin.into(), dir.into(), 0.0, tmax);
+        let mut best = Hit { t: f32::INFINITY, tri: 0, b: Vec2::ZERO };
+        let mut rh = RayHit::none();
+        self.bvh.ray_traverse(ray, &mut rh, |r, leaf| {
+            let (t, b) = self.intersect(r, leaf);
+            if t < best.t {
+                let hit = Hit { t, tri: leaf as u32, b };
+                if self.accepts(mats, &hit, key) {
+                    best = hit;
+                    return t;
+                }
+            }
+            f32::INFINITY
+        });
+        (best.t < tmax).then_some(best)
+    }
+
+    /// Every surface along the ray up to `tmax`, sorted front to back, into `out` (cleared).
+    /// Duplicate reports of one surface (shared edges, split leaves) are removed.
+    pub fn all_hits(&self, origin: Vec3, dir: Vec3, tmax: f32, out: &mut Vec<Hit>) {
+        out.clear();
+        let ray = Ray::new(origin.into(), dir.into(), 0.0, tmax);
+        self.bvh.ray_traverse_anyhit(ray, |r, leaf| {
+            let (t, b) = self.intersect(r, leaf);
+            if t.is_finite() {
+                out.push(Hit { t, tri: leaf as u32, b });
+            }
+        });
+        out.sort_unstable_by(|a, b| a.t.total_cmp(&b.t).then(a.tri.cmp(&b.tri)));
+        out.dedup_by(|b, a| {
+            let (sa, sb) = (&self.shading[a.tri as usize], &self.shading[b.tri as usize]);
+            sa.id == sb.id || (sa.object == sb.object && (b.t - a.t) <= 1e-5 * a.t.max(1.0))
+        });
+    }
+
+    /// Fraction of light passing from `origin` along `dir` to distance `tmax`: the product of
+    /// `1 - opacity` over semi-transparent surfaces; opaque surfaces and glass block.
+    pub fn transmittance(&self, mats: &[RenderMaterial], origin: Vec3, dir: Vec3, tmax: f32) -> f32 {
+        let ray = Ray::new(origin.into(), dir.into(), 0.0, tmax);
+        let mut tr = 1.0f32;
+        let clear = self.bvh.ray_traverse_miss(ray, |r, leaf| {
+            let (t, b) = self.intersect(r, leaf);
+            if t.is_finite() {
+                let hit = Hit { t, tri: leaf as u32, b };
+                let m = &mats[self.shading[leaf].material as usize];
+                let a = if m.glass_ior.is_some() { 1.0 } else { self.opacity(mats, &hit) };
+                if a >= 1.0 {
+                    return t;
+                }
+                tr *= 1.0 - a;
+            }
+            f32::INFINITY
+        });
+        if clear { tr } else { 0.0 }
+    }
+
+    /// GT coverage of a hit: opacity, times the Fresnel reflectance for glass (the part of the
+    /// pixel's light that does not come from behind the surface).
+    #[inline]
+    pub fn coverage(&self, mats: &[RenderMaterial], hit: &Hit, dir: Vec3) -> f32 {
+        let m = &mats[self.shading[hit.tri as usize].material as usize];
+        let a = self.opacity(mats, hit);
+        match m.glass_ior {
+            Some(ior) => {
+                let cos = dir.normalize().dot(self.geometric_normal(hit.tri)).abs();
+                a * super::bsdf::fresnel_dielectric(cos, ior).0
+            }
+            None => a,
+        }
+    }
+}

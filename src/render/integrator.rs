@@ -1,0 +1,148 @@
+//! Unidirectional path tracing with next-event estimation, MIS (power heuristic), Russian
+//! roulette and stochastic transparency.
+
+use super::RenderScene;
+use super::bsdf::{Frame, power_heuristic};
+use super::geometry::Hit;
+use super::sampler::Sampler;
+use glam::Vec3;
+
+/// Path-tracing limits.
+#[derive(Clone, Copy, Debug)]
+pub struct PathSettings {
+    pub max_depth: u32,
+    pub rr_depth: u32,
+}
+
+/// Offset for spawning rays off a surface, relative to the scene scale.
+const RAY_EPS: f32 = 1e-4;
+
+/// How the path arrived at the current vertex (for MIS on emitters).
+#[derive(Clone, Copy)]
+struct Arrival {
+    pdf: f32,
+    is_delta: bool,
+}
+
+impl RenderScene {
+    /// Radiance arriving along `dir` at `origin`, given the first surface already chosen
+    /// (`first`, from the caller's traversal; `None` means the ray escaped).
+    pub fn radiance(
+        &self,
+        settings: &PathSettings,
+        origin: Vec3,
+        dir: Vec3,
+        first: Option<Hit>,
+        sampler: &mut Sampler,
+    ) -> Vec3 {
+        let (mut origin, mut dir, mut hit) = (origin, dir, first);
+        let mut radiance = Vec3::ZERO;
+        let mut beta = Vec3::ONE;
+        let mut arrival = Arrival { pdf: 0.0, is_delta: true };
+        for depth in 0..settings.max_depth {
+            let Some(h) = hit else {
+                radiance += beta * self.environment;
+                break;
+            };
+            let p = origin + dir * h.t;
+            radiance += beta * self.emitted(&h, origin, dir, arrival);
+            let s = &self.geometry.shading[h.tri as usize];
+            let mat = &self.materials[s.material as usize];
+            let bsdf = mat.surface(self.geometry.uv(&h));
+            let wo = -dir.normalize();
+            let frame = Frame::from_normal(self.shading_normal(&h, wo, mat.glass_ior.is_some()));
+            let wo_l = frame.to_local(wo);
+            if !bsdf.is_delta() && !self.lights.is_empty() {
+                radiance += beta * self.direct_light(p, &h, &frame, wo_l, &bsdf, sampler);
+            }
+            let Some(bs) = bsdf.sample(wo_l, sampler.next(), sampler.next2()) else { break };
+            if bs.pdf <= 0.0 {
+                break;
+            }
+            beta *= bs.f * bs.wi.z.abs() / bs.pdf;
+            arrival = Arrival { pdf: bs.pdf, is_delta: bs.is_delta };
+            if depth + 1 >= settings.rr_depth {
+                let survive = beta.max_element().min(0.95);
+                if sampler.next() >= survive {
+                    break;
+                }
+                beta /= survive;
+            }
+            dir = frame.to_world(bs.wi);
+            origin = self.spawn(p, h.tri, dir);
+            hit = self.geometry.closest(&self.materials, origin, dir, f32::INFINITY, sampler.next_key());
+        }
+        radiance
+    }
+
+    /// Emission picked up at a hit, MIS-weighted against light sampling unless the path
+    /// arrived by a delta lobe (or from the camera).
+    fn emitted(&self, h: &Hit, origin: Vec3, dir: Vec3, arrival: Arrival) -> Vec3 {
+        let mat = &self.materials[self.geometry.shading[h.tri as usize].material as usize];
+        let ng = self.geometry.geometric_normal(h.tri);
+        let dist = dir.length() * h.t;
+        let cos_light = -dir.normalize().dot(ng);
+        if !mat.is_emissive() || cos_light <= 0.0 {
+            return Vec3::ZERO;
+        }
+        if arrival.is_delta {
+            return mat.emission;
+        }
+        let _ = origin;
+        let light_pdf = self.lights.pdf(&self.geometry, h.tri, dist, cos_light);
+        mat.emission * power_heuristic(arrival.pdf, light_pdf)
+    }
+
+    /// One light sample with a shadow ray through semi-transparent surfaces.
+    fn direct_light(
+        &self,
+        p: Vec3,
+        h: &Hit,
+        frame: &Frame,
+        wo_l: Vec3,
+        bsdf: &super::bsdf::SurfaceParams,
+        sampler: &mut Sampler,
+    ) -> Vec3 {
+        let ls = self.lights.sample(&self.geometry, &self.materials, sampler.next(), sampler.next2());
+        let to_light = ls.p - p;
+        let dist = to_light.length();
+        let wi = to_light / dist;
+        let cos_light = -wi.dot(ls.n);
+        if cos_light <= 0.0 || dist <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let wi_l = frame.to_local(wi);
+        let (f, bsdf_pdf) = bsdf.eval(wo_l, wi_l);
+        if f == Vec3::ZERO {
+            return Vec3::ZERO;
+        }
+        let origin = self.spawn(p, h.tri, wi);
+        let tmax = (ls.p - origin).length() * (1.0 - 1e-3);
+        let tr = self.geometry.transmittance(&self.materials, origin, wi, tmax);
+        if tr <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let light_pdf = ls.pdf_area * dist * dist / cos_light;
+        f * ls.emission * (tr * wi_l.z.abs() * power_heuristic(light_pdf, bsdf_pdf) / light_pdf)
+    }
+
+    /// Shading normal; opaque surfaces are two-sided, so it is turned towards the viewer.
+    /// Glass keeps its outward orientation so the BSDF knows inside from outside.
+    fn shading_normal(&self, h: &Hit, wo: Vec3, is_glass: bool) -> Vec3 {
+        let ng = self.geometry.geometric_normal(h.tri);
+        let ns = self.geometry.shading_normal(h);
+        if is_glass {
+            return if ns.dot(ng) > 0.0 { ns } else { ng };
+        }
+        let ng = if ng.dot(wo) < 0.0 { -ng } else { ng };
+        let ns = if ns.dot(ng) < 0.0 { -ns } else { ns };
+        if ns.dot(wo) > 0.0 { ns } else { ng }
+    }
+
+    /// Ray origin just off the surface, on the side `dir` leaves to.
+    fn spawn(&self, p: Vec3, tri: u32, dir: Vec3) -> Vec3 {
+        let ng = self.geometry.geometric_normal(tri);
+        let eps = RAY_EPS * p.abs().max_element().max(1.0);
+        p + ng * eps.copysign(ng.dot(dir))
+    }
+}

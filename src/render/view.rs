@@ -1,0 +1,185 @@
+//! Rendering one view: colour for every view, and the multimodal ground truth in the same pass
+//! for the views that need it.
+
+use super::RenderScene;
+use super::geometry::Hit;
+use super::integrator::PathSettings;
+use super::sampler::Sampler;
+use super::slices::{SliceAccumulator, SliceHit};
+use crate::camera::{LightFieldCamera, ViewRays};
+use crate::scene::SliceRange;
+use glam::Vec3;
+use lfformat::{Mode, ModeMap};
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Everything a view render needs besides the scene and camera.
+#[derive(Clone, Copy, Debug)]
+pub struct RenderSettings {
+    pub path: PathSettings,
+    pub spp: u32,
+    pub seed: u64,
+    pub scene_index: u64,
+    pub mode_epsilon: f32,
+}
+
+/// Linear radiance, row-major from the top-left.
+pub struct ViewImage {
+    pub width: usize,
+    pub height: usize,
+    pub pixels: Vec<Vec3>,
+}
+
+/// Ground truth of one view.
+pub struct ViewGt {
+    pub modes: ModeMap,
+    /// Linear colour of each mode, in [`ModeMap`] storage order.
+    pub colors: Vec<[f32; 3]>,
+    /// HCI single-valued depth: the first surface with coverage ≥ 0.5 on the pixel-centre ray
+    /// (NaN where there is none).
+    pub hci_depth: Vec<f32>,
+}
+
+pub struct ViewOutput {
+    pub image: ViewImage,
+    pub gt: Option<ViewGt>,
+}
+
+/// Rows per parallel work item: small enough to balance two to many cores.
+const BAND_ROWS: u32 = 2;
+
+/// Per-thread scratch buffers, reused for every pixel of a band.
+struct Scratch {
+    hits: Vec<Hit>,
+    slice_hits: Vec<SliceHit>,
+    acc: SliceAccumulator,
+}
+
+/// Output of one band of rows.
+#[derive(Default)]
+struct Band {
+    pixels: Vec<Vec3>,
+    modes: Vec<Mode>,
+    mode_counts: Vec<u32>,
+    colors: Vec<[f32; 3]>,
+    hci_depth: Vec<f32>,
+}
+
+impl RenderScene {
+    /// Renders `view`; `samples_done` counts camera samples for progress reporting.
+    pub fn render_view(
+        &self,
+        cam: &LightFieldCamera,
+        slices: &SliceRange,
+        settings: &RenderSettings,
+        view: u32,
+        with_gt: bool,
+        samples_done: &AtomicU64,
+    ) -> ViewOutput {
+        let (w, h) = (cam.width(), cam.height());
+        let rays = cam.view_rays(view);
+        let bands: Vec<Band> = (0..h.div_ceil(BAND_ROWS))
+            .into_par_iter()
+            .map_init(
+                || Scratch { hits: Vec::new(), slice_hits: Vec::new(), acc: SliceAccumulator::new(slices.count as usize) },
+                |scratch, b| {
+                    let rows = b * BAND_ROWS..((b + 1) * BAND_ROWS).min(h);
+                    let mut band = Band::default();
+                    for y in rows {
+                        for x in 0..w {
+                            let ctx = PixelCtx { scene: self, cam, rays: &rays, slices, settings, view, x, y };
+                            ctx.render(with_gt, scratch, &mut band);
+                        }
+                        samples_done.fetch_add(w as u64 * settings.spp as u64, Ordering::Relaxed);
+                    }
+                    band
+                },
+            )
+            .collect();
+        assemble(w as usize, h as usize, bands, with_gt)
+    }
+}
+
+/// Joins bands (in row order) into the view's image and ground truth.
+fn assemble(width: usize, height: usize, bands: Vec<Band>, with_gt: bool) -> ViewOutput {
+    let mut pixels = Vec::with_capacity(width * height);
+    let mut modes = ModeMap::new(width, height);
+    let (mut colors, mut hci_depth) = (Vec::new(), Vec::new());
+    for band in bands {
+        pixels.extend(band.pixels);
+        let mut start = 0;
+        for n in band.mode_counts {
+            modes.push_pixel(&band.modes[start..start + n as usize]);
+            start += n as usize;
+        }
+        colors.extend(band.colors);
+        hci_depth.extend(band.hci_depth);
+    }
+    let gt = with_gt.then_some(ViewGt { modes, colors, hci_depth });
+    ViewOutput { image: ViewImage { width, height, pixels }, gt }
+}
+
+/// One pixel's render inputs.
+struct PixelCtx<'a> {
+    scene: &'a RenderScene,
+    cam: &'a LightFieldCamera,
+    rays: &'a ViewRays,
+    slices: &'a SliceRange,
+    settings: &'a RenderSettings,
+    view: u32,
+    x: u32,
+    y: u32,
+}
+
+impl PixelCtx<'_> {
+    fn render(&self, with_gt: bool, scratch: &mut Scratch, band: &mut Band) {
+        let s = self.settings;
+        let mut sampler = Sampler::new(s.seed, s.scene_index, self.view, self.x, self.y, s.spp);
+        let mut sum = Vec3::ZERO;
+        for i in 0..s.spp {
+            let off = sampler.pixel_offset(i);
+            let ray = self.rays.ray(self.x as f32 + off.x, self.y as f32 + off.y);
+            let key = sampler.next_key();
+            let first = if with_gt {
+                self.trace_all(ray.origin, ray.dir, key, scratch)
+            } else {
+                self.scene.geometry.closest(&self.scene.materials, ray.origin, ray.dir, f32::INFINITY, key)
+            };
+            let radiance = self.scene.radiance(&s.path, ray.origin, ray.dir, first, &mut sampler);
+            if let (true, Some(f)) = (with_gt, first) {
+                scratch.acc.add_color(self.slices, f.t, radiance, 1.0);
+            }
+            sum += radiance;
+        }
+        band.pixels.push(sum / s.spp as f32);
+        if with_gt {
+            let before = band.modes.len();
+            let cam = self.cam;
+            scratch.acc.finish_pixel(|z| cam.disparity(z), s.mode_epsilon, &mut band.modes, &mut band.colors);
+            band.mode_counts.push((band.modes.len() - before) as u32);
+            band.hci_depth.push(self.hci_depth(scratch));
+        }
+    }
+
+    /// Collects every hit of a sample ray into the slice accumulator and returns the surface
+    /// the colour path continues from (the first one kept by stochastic transparency).
+    fn trace_all(&self, origin: Vec3, dir: Vec3, key: u64, scratch: &mut Scratch) -> Option<Hit> {
+        let (geo, mats) = (&self.scene.geometry, &self.scene.materials);
+        geo.all_hits(origin, dir, f32::INFINITY, &mut scratch.hits);
+        scratch.slice_hits.clear();
+        scratch
+            .slice_hits
+            .extend(scratch.hits.iter().map(|h| SliceHit { z: h.t, coverage: geo.coverage(mats, h, dir) }));
+        scratch.acc.add_sample(self.slices, &scratch.slice_hits);
+        scratch.hits.iter().find(|h| geo.accepts(mats, h, key)).copied()
+    }
+
+    /// HCI semantics: depth of the first surface with coverage ≥ 0.5 on the pixel-centre ray.
+    fn hci_depth(&self, scratch: &mut Scratch) -> f32 {
+        let (geo, mats) = (&self.scene.geometry, &self.scene.materials);
+        let ray = self.rays.ray(self.x as f32 + 0.5, self.y as f32 + 0.5);
+        geo.all_hits(ray.origin, ray.dir, f32::INFINITY, &mut scratch.hits);
+        let first = scratch.hits.iter().find(|h| geo.coverage(mats, h, ray.dir) >= 0.5);
+        first.map_or(f32::NAN, |h| h.t)
+    }
+}

@@ -1,0 +1,150 @@
+//! Materials and the procedural textures they read (evaluated on UVs measured in metres, so a
+//! texture tiles at its real size whatever the object).
+
+use glam::{Vec2, Vec3};
+use serde::{Deserialize, Serialize};
+
+/// A surface: scattering model, base colour, opacity (cut-outs, semi-transparency), emission.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Material {
+    pub name: String,
+    pub model: SurfaceModel,
+    pub base_color: Texture,
+    pub roughness: f32,
+    pub metallic: f32,
+    /// Surface coverage in [0, 1]: the α of the slices and the stochastic-transparency weight.
+    pub opacity: Opacity,
+    /// Emitted radiance (linear RGB); non-zero makes the surface an area light.
+    pub emission: [f32; 3],
+}
+
+/// The scattering model of a material.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum SurfaceModel {
+    /// Lambert diffuse under a GGX glossy layer.
+    Standard,
+    /// Smooth dielectric.
+    Glass { ior: f32 },
+}
+
+/// Base-colour textures (linear RGB).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum Texture {
+    Constant { color: [f32; 3] },
+    /// Squares of side `size` metres.
+    Checker { a: [f32; 3], b: [f32; 3], size: f32 },
+    /// Stripes along U of width `width` metres.
+    Stripes { a: [f32; 3], b: [f32; 3], width: f32 },
+    /// Smooth value noise blending `a` and `b`, feature size `scale` metres.
+    Noise { a: [f32; 3], b: [f32; 3], scale: f32, seed: u32 },
+}
+
+/// Opacity: a constant, or an alpha pattern (a grid of bars, a woven mesh).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum Opacity {
+    Constant { value: f32 },
+    /// Bars of width `bar·period` every `period` metres in U and V, opacity `value` on the
+    /// bars and 0 in the holes.
+    Grid { value: f32, period: f32, bar: f32 },
+}
+
+impl Material {
+    pub fn is_emissive(&self) -> bool {
+        self.emission.iter().any(|&e| e > 0.0)
+    }
+}
+
+impl Texture {
+    pub fn constant(c: [f32; 3]) -> Self {
+        Texture::Constant { color: c }
+    }
+
+    pub fn eval(&self, uv: Vec2) -> Vec3 {
+        match *self {
+            Texture::Constant { color } => color.into(),
+            Texture::Checker { a, b, size } => {
+                let cell = (uv / size).floor();
+                pick(a, b, (cell.x + cell.y).rem_euclid(2.0) as f32)
+            }
+            Texture::Stripes { a, b, width } => pick(a, b, (uv.x / width).floor().rem_euclid(2.0)),
+            Texture::Noise { a, b, scale, seed } => pick(a, b, value_noise(uv / scale, seed)),
+        }
+    }
+}
+
+impl Opacity {
+    pub fn constant(value: f32) -> Self {
+        Opacity::Constant { value }
+    }
+
+    /// `Some(a)` when the opacity does not depend on the surface position (the fast path).
+    pub fn uniform(&self) -> Option<f32> {
+        match *self {
+            Opacity::Constant { value } => Some(value),
+            Opacity::Grid { .. } => None,
+        }
+    }
+
+    pub fn eval(&self, uv: Vec2) -> f32 {
+        match *self {
+            Opacity::Constant { value } => value,
+            Opacity::Grid { value, period, bar } => {
+                let f = (uv / period).fract_gl();
+                if f.x < bar || f.y < bar { value } else { 0.0 }
+            }
+        }
+    }
+}
+
+fn pick(a: [f32; 3], b: [f32; 3], t: f32) -> Vec3 {
+    Vec3::from(a).lerp(Vec3::from(b), t)
+}
+
+/// Smoothly interpolated lattice noise in [0, 1].
+fn value_noise(p: Vec2, seed: u32) -> f32 {
+    let cell = p.floor();
+    let f = p - cell;
+    let s = f * f * (Vec2::splat(3.0) - 2.0 * f);
+    let (i, j) = (cell.x as i32, cell.y as i32);
+    let h = |di: i32, dj: i32| lattice(i + di, j + dj, seed);
+    let top = h(0, 0) + (h(1, 0) - h(0, 0)) * s.x;
+    let bottom = h(0, 1) + (h(1, 1) - h(0, 1)) * s.x;
+    top + (bottom - top) * s.y
+}
+
+fn lattice(i: i32, j: i32, seed: u32) -> f32 {
+    let key = ((i as u32 as u64) << 32 | j as u32 as u64) ^ ((seed as u64) << 17);
+    (crate::render::sampler::mix64(key) >> 40) as f32 / (1u64 << 24) as f32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn checker_and_grid_patterns() {
+        let t = Texture::Checker { a: [0.0; 3], b: [1.0; 3], size: 0.5 };
+        assert_eq!(t.eval(Vec2::new(0.1, 0.1)).x, 0.0);
+        assert_eq!(t.eval(Vec2::new(0.6, 0.1)).x, 1.0);
+        assert_eq!(t.eval(Vec2::new(-0.1, 0.1)).x, 1.0);
+        let g = Opacity::Grid { value: 0.9, period: 0.1, bar: 0.2 };
+        assert_eq!(g.eval(Vec2::new(0.01, 0.05)), 0.9);
+        assert_eq!(g.eval(Vec2::new(0.05, 0.05)), 0.0);
+        assert_eq!(g.uniform(), None);
+    }
+
+    #[test]
+    fn noise_is_continuous_and_bounded() {
+        let t = Texture::Noise { a: [0.0; 3], b: [1.0; 3], scale: 1.0, seed: 7 };
+        let mut prev = t.eval(Vec2::ZERO).x;
+        for k in 1..2000 {
+            let v = t.eval(Vec2::new(k as f32 * 1e-3, 0.3)).x;
+            assert!((0.0..=1.0).contains(&v));
+            assert!((v - prev).abs() < 0.01, "jump at {k}");
+            prev = v;
+        }
+    }
+}

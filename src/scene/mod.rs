@@ -1,0 +1,106 @@
+//! The scene description: everything needed to render a scene again (`scene.json`).
+//!
+//! A scene is data, not code: shapes with parameters, transforms, materials and lights, plus the
+//! camera. [`shapes`] turns it into world-space triangles; the renderer never sees this module's
+//! serialisation, and the writers never see the triangles.
+
+pub mod builtin;
+pub mod material;
+pub mod shapes;
+
+use crate::camera::LightFieldCamera;
+use crate::config::SliceSpacing;
+use glam::{Quat, Vec3};
+pub use material::{Material, Opacity, SurfaceModel, Texture};
+use serde::{Deserialize, Serialize};
+
+/// A complete, re-renderable scene.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SceneDesc {
+    /// `lfgen <version>` that produced it.
+    pub generator: String,
+    pub name: String,
+    /// Scene index within the dataset and the dataset seed (RNG streams derive from both).
+    pub index: u64,
+    pub seed: u64,
+    pub camera: LightFieldCamera,
+    /// The slice partition of the ground truth; fixed per scene so every view uses the same one.
+    pub slices: SliceRange,
+    /// Radiance of rays leaving the scene (linear RGB).
+    pub environment: [f32; 3],
+    /// Linear scale applied before sRGB encoding (chosen from the centre view when automatic).
+    pub exposure: f32,
+    pub materials: Vec<Material>,
+    pub objects: Vec<Object>,
+}
+
+/// The depth range `[z_near, z_far]` cut into `count` slices.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SliceRange {
+    pub z_near: f64,
+    pub z_far: f64,
+    pub count: u32,
+    pub spacing: SliceSpacing,
+}
+
+impl SliceRange {
+    /// Slice of planar depth `z`; depths outside the range go to the first / last slice.
+    #[inline]
+    pub fn index(&self, z: f32) -> usize {
+        let (a, b, v) = match self.spacing {
+            SliceSpacing::Depth => (self.z_near, self.z_far, z as f64),
+            SliceSpacing::Disparity => (1.0 / self.z_near, 1.0 / self.z_far, 1.0 / z as f64),
+        };
+        let k = ((v - a) / (b - a) * self.count as f64).floor();
+        k.clamp(0.0, (self.count - 1) as f64) as usize
+    }
+}
+
+/// One placed shape.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Object {
+    pub name: String,
+    pub shape: Shape,
+    pub transform: Transform,
+    /// Index into [`SceneDesc::materials`].
+    pub material: u32,
+}
+
+/// Parametric shapes, in local coordinates (metres).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum Shape {
+    /// Axis-aligned box centred at the origin, outward normals.
+    Cuboid { size: Vec3 },
+    /// Inward-facing box from `(-w/2, 0, -d/2)` to `(w/2, h, d/2)`: floor, walls, ceiling.
+    Room { size: Vec3 },
+    /// Rectangle in the local XY plane centred at the origin, normal +Z.
+    Quad { size: [f32; 2] },
+    /// UV sphere centred at the origin.
+    Sphere { radius: f32, rings: u32, segments: u32 },
+    /// Closed cylinder standing on the origin along +Y.
+    Cylinder { radius: f32, height: f32, segments: u32 },
+}
+
+/// Scale, then rotate, then translate.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Transform {
+    pub translation: Vec3,
+    pub rotation: Quat,
+    pub scale: Vec3,
+}
+
+impl Transform {
+    pub fn at(translation: Vec3) -> Self {
+        Self { translation, rotation: Quat::IDENTITY, scale: Vec3::ONE }
+    }
+
+    pub fn rotated_y(mut self, angle: f32) -> Self {
+        self.rotation = Quat::from_rotation_y(angle) * self.rotation;
+        self
+    }
+
+    pub fn matrix(&self) -> glam::Mat4 {
+        glam::Mat4::from_scale_rotation_translation(self.scale, self.rotation, self.translation)
+    }
+}

@@ -1,0 +1,172 @@
+//! Tessellation of [`Shape`]s into world-space triangles with normals and metre-scaled UVs.
+
+use super::{Shape, Transform};
+use glam::{Mat3, Vec2, Vec3};
+use std::f32::consts::{PI, TAU};
+
+/// One world-space triangle with per-vertex shading normals and UVs (metres).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MeshTri {
+    pub p: [Vec3; 3],
+    pub n: [Vec3; 3],
+    pub uv: [Vec2; 3],
+}
+
+/// Appends the triangles of `shape` placed by `xf` to `out`.
+pub fn tessellate(shape: &Shape, xf: &Transform, out: &mut Vec<MeshTri>) {
+    let start = out.len();
+    match *shape {
+        Shape::Cuboid { size } => cuboid(size, Vec3::ZERO, false, out),
+        Shape::Room { size } => cuboid(size, Vec3::new(0.0, size.y / 2.0, 0.0), true, out),
+        Shape::Quad { size } => quad(
+            [Vec3::new(-0.5, -0.5, 0.0), Vec3::X, Vec3::Y].map(|v| v * Vec3::new(size[0], size[1], 1.0)),
+            out,
+        ),
+        Shape::Sphere { radius, rings, segments } => sphere(radius, rings.max(2), segments.max(3), out),
+        Shape::Cylinder { radius, height, segments } => cylinder(radius, height, segments.max(3), out),
+    }
+    let m = xf.matrix();
+    let nm = Mat3::from_mat4(m).inverse().transpose();
+    for t in &mut out[start..] {
+        t.p = t.p.map(|p| m.transform_point3(p));
+        t.n = t.n.map(|n| (nm * n).normalize_or_zero());
+    }
+}
+
+/// A parallelogram `origin + s·edge_u + t·edge_v`, normal `edge_u × edge_v`, UVs in metres.
+fn quad([origin, eu, ev]: [Vec3; 3], out: &mut Vec<MeshTri>) {
+    let n = eu.cross(ev).normalize();
+    let (lu, lv) = (eu.length(), ev.length());
+    let c = [origin, origin + eu, origin + eu + ev, origin + ev];
+    let uv = [Vec2::ZERO, Vec2::new(lu, 0.0), Vec2::new(lu, lv), Vec2::new(0.0, lv)];
+    for [a, b, d] in [[0, 1, 2], [0, 2, 3]] {
+        out.push(MeshTri { p: [c[a], c[b], c[d]], n: [n; 3], uv: [uv[a], uv[b], uv[d]] });
+    }
+}
+
+/// Six faces of a box centred at `centre`; `inward` flips every face (a room seen from inside).
+fn cuboid(size: Vec3, centre: Vec3, inward: bool, out: &mut Vec<MeshTri>) {
+    let h = size / 2.0;
+    for axis in 0..3 {
+        for sign in [-1.0f32, 1.0] {
+            let n = Vec3::AXES[axis] * sign;
+            let (a1, a2) = ((axis + 1) % 3, (axis + 2) % 3);
+            let (mut eu, ev) = (Vec3::AXES[a1] * size[a1], Vec3::AXES[a2] * size[a2]);
+            // Orient each face so eu × ev points along the wanted normal.
+            let wanted = if inward { -n } else { n };
+            if eu.cross(ev).dot(wanted) < 0.0 {
+                eu = -eu;
+            }
+            let origin = centre + n * h[axis] - eu / 2.0 - ev / 2.0;
+            quad([origin, eu, ev], out);
+        }
+    }
+}
+
+fn sphere(radius: f32, rings: u32, segments: u32, out: &mut Vec<MeshTri>) {
+    let point = |i: u32, j: u32| {
+        let (theta, phi) = (PI * i as f32 / rings as f32, TAU * j as f32 / segments as f32);
+        let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin());
+        let uv = Vec2::new(phi * radius, theta * radius);
+        (n * radius, n, uv)
+    };
+    grid_mesh(rings, segments, point, out);
+}
+
+fn cylinder(radius: f32, height: f32, segments: u32, out: &mut Vec<MeshTri>) {
+    let side = |i: u32, j: u32| {
+        let phi = TAU * j as f32 / segments as f32;
+        let n = Vec3::new(phi.cos(), 0.0, -phi.sin());
+        let y = height * i as f32;
+        (n * radius + Vec3::Y * (height - y), n, Vec2::new(phi * radius, height - y))
+    };
+    grid_mesh(1, segments, side, out);
+    for (y, n) in [(0.0, -Vec3::Y), (height, Vec3::Y)] {
+        let rim = |j: u32| {
+            let phi = TAU * j as f32 / segments as f32;
+            Vec3::new(radius * phi.cos(), y, -radius * phi.sin())
+        };
+        let centre = Vec3::new(0.0, y, 0.0);
+        for j in 0..segments {
+            let (mut a, mut b) = (rim(j), rim(j + 1));
+            if (a - centre).cross(b - centre).dot(n) < 0.0 {
+                std::mem::swap(&mut a, &mut b);
+            }
+            let uv = [centre, a, b].map(|p| Vec2::new(p.x, p.z));
+            out.push(MeshTri { p: [centre, a, b], n: [n; 3], uv });
+        }
+    }
+}
+
+/// Triangulates a `rows × cols` parametric patch; `f(i, j)` gives position, normal and UV.
+/// Degenerate triangles (at the poles) are skipped.
+fn grid_mesh(
+    rows: u32,
+    cols: u32,
+    f: impl Fn(u32, u32) -> (Vec3, Vec3, Vec2),
+    out: &mut Vec<MeshTri>,
+) {
+    for i in 0..rows {
+        for j in 0..cols {
+            let v = [f(i, j), f(i + 1, j), f(i + 1, j + 1), f(i, j + 1)];
+            for [a, b, c] in [[0, 1, 2], [0, 2, 3]] {
+                let p = [v[a].0, v[b].0, v[c].0];
+                if (p[1] - p[0]).cross(p[2] - p[0]).length_squared() > 1e-12 {
+                    out.push(MeshTri { p, n: [v[a].1, v[b].1, v[c].1], uv: [v[a].2, v[b].2, v[c].2] });
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tris(shape: Shape) -> Vec<MeshTri> {
+        let mut out = Vec::new();
+        tessellate(&shape, &Transform::at(Vec3::new(1.0, 2.0, 3.0)), &mut out);
+        out
+    }
+
+    /// Signed volume by the divergence theorem: positive for outward-facing closed meshes.
+    fn volume(t: &[MeshTri]) -> f32 {
+        let c = Vec3::new(1.0, 2.0, 3.0);
+        t.iter().map(|t| (t.p[0] - c).dot((t.p[1] - c).cross(t.p[2] - c)) / 6.0).sum()
+    }
+
+    #[test]
+    fn closed_shapes_have_their_analytic_volume_and_face_outwards() {
+        let v = volume(&tris(Shape::Cuboid { size: Vec3::new(1.0, 2.0, 3.0) }));
+        assert!((v - 6.0).abs() < 1e-4, "{v}");
+        let v = volume(&tris(Shape::Room { size: Vec3::new(2.0, 2.0, 2.0) }));
+        assert!((v + 8.0).abs() < 1e-4, "room faces inwards: {v}");
+        let v = volume(&tris(Shape::Sphere { radius: 1.0, rings: 64, segments: 128 }));
+        assert!((v - 4.0 / 3.0 * PI).abs() < 0.01, "{v}");
+        let v = volume(&tris(Shape::Cylinder { radius: 0.5, height: 2.0, segments: 256 }));
+        assert!((v - PI * 0.5).abs() < 0.01, "{v}");
+    }
+
+    #[test]
+    fn shading_normals_agree_with_winding() {
+        for shape in [
+            Shape::Cuboid { size: Vec3::ONE },
+            Shape::Sphere { radius: 1.0, rings: 8, segments: 16 },
+            Shape::Cylinder { radius: 1.0, height: 1.0, segments: 16 },
+            Shape::Quad { size: [1.0, 2.0] },
+        ] {
+            for t in tris(shape.clone()) {
+                let ng = (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]);
+                assert!(ng.dot(t.n[0] + t.n[1] + t.n[2]) > 0.0, "{shape:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn quad_uvs_are_metres() {
+        let t = tris(Shape::Quad { size: [2.0, 0.5] });
+        let max_u = t.iter().flat_map(|t| t.uv).map(|uv| uv.x).fold(0.0, f32::max);
+        let max_v = t.iter().flat_map(|t| t.uv).map(|uv| uv.y).fold(0.0, f32::max);
+        assert_eq!((max_u, max_v), (2.0, 0.5));
+    }
+}

@@ -1,0 +1,98 @@
+//! Per-scene figures (`stats.json`): how multimodal the ground truth is and what it spans.
+//!
+//! Nothing here depends on time or threads, so `stats.json` is as reproducible as the images;
+//! render timings go to the dataset's `timings.jsonl` instead.
+
+use lfformat::ModeMap;
+use serde::{Deserialize, Serialize};
+
+/// η above which a mode counts towards "multimodal" (thesis §5.3.2).
+pub const MULTIMODAL_ETA: f32 = 0.3;
+/// Bins of the disparity histogram.
+const HIST_BINS: usize = 64;
+
+/// Figures of one scene's centre-view ground truth.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SceneStats {
+    /// Fraction of pixels with at least two modes of η > 0.3.
+    pub multimodal_fraction: f64,
+    /// `mode_count_histogram[k]` = number of pixels with exactly k modes.
+    pub mode_count_histogram: Vec<u64>,
+    /// Min and max disparity over all modes.
+    pub disparity_range: [f64; 2],
+    /// Min and max of the HCI single-valued disparity map.
+    pub hci_disparity_range: [f64; 2],
+    /// η-weighted histogram of mode disparities over `disparity_range`, normalised to sum 1.
+    pub disparity_histogram: Vec<f64>,
+    /// Mean of Σ η over pixels (1 in a closed room).
+    pub mean_eta_sum: f64,
+    pub baseline_mm: f64,
+    pub focus_distance_m: f64,
+    pub depth_range_m: [f64; 2],
+    pub exposure: f32,
+    pub triangles: u64,
+    /// Creation date (parameters.cfg `date`).
+    pub date: String,
+}
+
+impl SceneStats {
+    /// Computes the ground-truth figures; camera and scene fields are filled by the caller.
+    pub fn from_gt(modes: &ModeMap, hci_disparity: &[f32]) -> Self {
+        let pixels = (modes.width * modes.height).max(1) as f64;
+        let mut counts = vec![0u64; modes.max_modes() + 1];
+        let (mut multimodal, mut eta_sum) = (0u64, 0.0f64);
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for px in modes.pixels() {
+            counts[px.len()] += 1;
+            multimodal += (px.iter().filter(|m| m.eta > MULTIMODAL_ETA).count() >= 2) as u64;
+            eta_sum += px.iter().map(|m| m.eta as f64).sum::<f64>();
+            for m in px {
+                lo = lo.min(m.disparity as f64);
+                hi = hi.max(m.disparity as f64);
+            }
+        }
+        let mut hist = vec![0.0f64; HIST_BINS];
+        let width = (hi - lo).max(1e-9);
+        for m in modes.pixels().flatten() {
+            let k = (((m.disparity as f64 - lo) / width * HIST_BINS as f64) as usize).min(HIST_BINS - 1);
+            hist[k] += m.eta as f64 / pixels;
+        }
+        let finite = hci_disparity.iter().filter(|d| d.is_finite()).map(|&d| d as f64);
+        let hci = finite.fold([f64::INFINITY, f64::NEG_INFINITY], |[a, b], d| [a.min(d), b.max(d)]);
+        Self {
+            multimodal_fraction: multimodal as f64 / pixels,
+            mode_count_histogram: counts,
+            disparity_range: [lo, hi],
+            hci_disparity_range: hci,
+            disparity_histogram: hist,
+            mean_eta_sum: eta_sum / pixels,
+            baseline_mm: 0.0,
+            focus_distance_m: 0.0,
+            depth_range_m: [0.0, 0.0],
+            exposure: 1.0,
+            triangles: 0,
+            date: String::new(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lfformat::Mode;
+
+    #[test]
+    fn counts_multimodal_pixels_and_histogram_mass() {
+        let mut map = ModeMap::new(2, 1);
+        let m = |d: f32, eta: f32| Mode { disparity: d, depth: 1.0, eta, eta_exact: eta };
+        map.push_pixel(&[m(1.0, 0.4), m(-1.0, 0.6)]);
+        map.push_pixel(&[m(0.0, 1.0)]);
+        let s = SceneStats::from_gt(&map, &[0.5, f32::NAN]);
+        assert_eq!(s.multimodal_fraction, 0.5);
+        assert_eq!(s.mode_count_histogram, vec![0, 1, 1]);
+        assert_eq!(s.disparity_range, [-1.0, 1.0]);
+        assert_eq!(s.hci_disparity_range, [0.5, 0.5]);
+        assert!((s.disparity_histogram.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+        assert!((s.mean_eta_sum - 1.0).abs() < 1e-12);
+    }
+}
