@@ -3,7 +3,6 @@
 
 use crate::config::Config;
 use crate::pipeline::{RenderJob, generate_scene};
-use crate::render::view::RenderSettings;
 use anyhow::Result;
 use rayon::prelude::*;
 use std::sync::atomic::AtomicU64;
@@ -52,13 +51,7 @@ pub fn run(cfg: &Config) -> Result<()> {
     println!("all hits (anyhit + sort + dedupe): {:.2} Mrays/s", n / all / 1e6);
     println!("all_hits_cost_ratio: {:.3}", all / closest);
     let job = RenderJob::from_config(&cfg, "");
-    let settings = RenderSettings {
-        path: job.path,
-        spp: job.spp,
-        seed: desc.seed,
-        scene_index: 0,
-        mode_epsilon: job.mode_epsilon,
-    };
+    let settings = job.settings(&desc);
     let counter = AtomicU64::new(0);
     let render = |gt: bool| time(|| drop(scene.render_view(cam, &desc.slices, &settings, cam.center_view(), gt, &counter)));
     // Alternate and keep the best of three to damp the noise of a shared machine.

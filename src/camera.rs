@@ -173,7 +173,7 @@ mod tests {
         let sx = f * du as f64 * c.baseline_m / c.focus_distance_m;
         let sy = f * dv as f64 * c.baseline_m / c.focus_distance_m;
         let x = 32.0 + f * rel.dot(c.right()) / z + sx;
-        let y = 24.0 - f * rel.dot(c.up) / z - sy;
+        let y = 24.0 - f * rel.dot(c.up) / z + sy;
         (x, y)
     }
 

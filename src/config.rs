@@ -310,11 +310,45 @@ fn check_known_key(path: &[&str]) -> Result<()> {
         match node.get(*p) {
             Some(toml::Value::Table(t)) if i + 1 < path.len() => node = t,
             Some(v) if i + 1 == path.len() && !v.is_table() => return Ok(()),
+            Some(_) if i + 1 == path.len() => bail!("{:?} is a section, not a key", path.join(".")),
             _ => {
                 let known: Vec<&String> = node.keys().collect();
                 bail!("unknown config key {:?} (known here: {known:?})", path.join("."));
             }
         }
     }
-    bail!("{:?} is a section, not a key", path.join("."))
+    unreachable!("the loop returns or fails on the last path element")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn generator_toml_documents_exactly_the_defaults() {
+        let text = include_str!("../generator.toml");
+        let parsed: Config = toml::from_str(text).expect("generator.toml parses");
+        assert_eq!(parsed, Config::default());
+        // And every default key appears in the file (so the file documents all of them).
+        let file: toml::Table = toml::from_str(text).unwrap();
+        let defaults = toml::Table::try_from(Config::default()).unwrap();
+        for (section, keys) in &defaults {
+            for key in keys.as_table().unwrap().keys() {
+                assert!(file[section].as_table().unwrap().contains_key(key), "{section}.{key} undocumented");
+            }
+        }
+    }
+
+    #[test]
+    fn sets_override_and_unknown_keys_are_named() {
+        let sets = ["camera.resolution=[64,48]".to_string(), "render.gt_views=all".to_string()];
+        let cfg = Config::load(None, &["quick".into()], &sets).unwrap();
+        assert_eq!(cfg.camera.resolution, [64, 48]);
+        assert_eq!(cfg.render.gt_views, GtViews::All);
+        assert_eq!(cfg.render.spp, 8, "preset applied");
+        let err = Config::load(None, &[], &["render.spp_=3".into()]).unwrap_err();
+        assert!(format!("{err:#}").contains("render.spp_"), "{err:#}");
+        let err = Config::load(None, &[], &["render=3".into()]).unwrap_err();
+        assert!(format!("{err:#}").contains("section"), "{err:#}");
+    }
 }

@@ -21,6 +21,8 @@ pub struct RenderJob {
     pub gt_views: GtViews,
     pub mode_epsilon: f32,
     pub write_exr: bool,
+    /// Shade every hit of GT rays (true slice colours).
+    pub shade_all_hits: bool,
     /// Choose the exposure from the centre view (else keep the scene's).
     pub auto_exposure: bool,
     /// Date written into parameters.cfg.
@@ -36,8 +38,21 @@ impl RenderJob {
             gt_views: r.gt_views,
             mode_epsilon: r.mode_epsilon as f32,
             write_exr: r.write_exr,
+            shade_all_hits: r.write_slices,
             auto_exposure: r.auto_exposure,
             date: date.to_string(),
+        }
+    }
+
+    /// Per-view render settings for scene `desc`.
+    pub fn settings(&self, desc: &SceneDesc) -> RenderSettings {
+        RenderSettings {
+            path: self.path,
+            spp: self.spp,
+            seed: desc.seed,
+            scene_index: desc.index,
+            mode_epsilon: self.mode_epsilon,
+            shade_all_hits: self.shade_all_hits,
         }
     }
 }
@@ -61,13 +76,7 @@ pub fn render_scene(
     samples_done: &AtomicU64,
 ) -> Result<Vec<FileEntry>> {
     let writer = SceneWriter::create(final_dir, job.write_exr)?;
-    let settings = RenderSettings {
-        path: job.path,
-        spp: job.spp,
-        seed: desc.seed,
-        scene_index: desc.index,
-        mode_epsilon: job.mode_epsilon,
-    };
+    let settings = job.settings(desc);
     let center = desc.camera.center_view();
     let per_view = job.gt_views == GtViews::All;
     // The centre view first: it fixes the exposure for all views and carries the GT.

@@ -21,6 +21,9 @@ pub struct RenderSettings {
     pub seed: u64,
     pub scene_index: u64,
     pub mode_epsilon: f32,
+    /// Shade every hit of GT rays, so mode colours are true slice colours (else each sample's
+    /// colour goes to the slice of the surface it saw).
+    pub shade_all_hits: bool,
 }
 
 /// Linear radiance, row-major from the top-left.
@@ -140,16 +143,12 @@ impl PixelCtx<'_> {
             let off = sampler.pixel_offset(i);
             let ray = self.rays.ray(self.x as f32 + off.x, self.y as f32 + off.y);
             let key = sampler.next_key();
-            let first = if with_gt {
-                self.trace_all(ray.origin, ray.dir, key, scratch)
+            sum += if with_gt {
+                self.sample_with_gt(ray.origin, ray.dir, key, &mut sampler, scratch)
             } else {
-                self.scene.geometry.closest(&self.scene.materials, ray.origin, ray.dir, f32::INFINITY, key)
+                let first = self.scene.geometry.closest(&self.scene.materials, ray.origin, ray.dir, f32::INFINITY, key);
+                self.scene.radiance(&s.path, ray.origin, ray.dir, first, &mut sampler)
             };
-            let radiance = self.scene.radiance(&s.path, ray.origin, ray.dir, first, &mut sampler);
-            if let (true, Some(f)) = (with_gt, first) {
-                scratch.acc.add_color(self.slices, f.t, radiance, 1.0);
-            }
-            sum += radiance;
         }
         band.pixels.push(sum / s.spp as f32);
         if with_gt {
@@ -161,17 +160,29 @@ impl PixelCtx<'_> {
         }
     }
 
-    /// Collects every hit of a sample ray into the slice accumulator and returns the surface
-    /// the colour path continues from (the first one kept by stochastic transparency).
-    fn trace_all(&self, origin: Vec3, dir: Vec3, key: u64, scratch: &mut Scratch) -> Option<Hit> {
-        let (geo, mats) = (&self.scene.geometry, &self.scene.materials);
+    /// Collects every hit of a sample ray into the slice accumulator and returns the radiance
+    /// of the surface the colour path continues from (the first kept by stochastic
+    /// transparency), exactly as the colour-only path would.
+    fn sample_with_gt(&self, origin: Vec3, dir: Vec3, key: u64, sampler: &mut Sampler, scratch: &mut Scratch) -> Vec3 {
+        let (scene, geo, mats) = (self.scene, &self.scene.geometry, &self.scene.materials);
         geo.all_hits(origin, dir, f32::INFINITY, &mut scratch.hits);
+        let first = scratch.hits.iter().position(|h| geo.accepts(mats, h, key));
+        let path = &self.settings.path;
+        let radiance = scene.radiance(path, origin, dir, first.map(|i| scratch.hits[i]), sampler);
         scratch.slice_hits.clear();
-        scratch
-            .slice_hits
-            .extend(scratch.hits.iter().map(|h| SliceHit { z: h.t, coverage: geo.coverage(mats, h, dir) }));
+        for (i, h) in scratch.hits.iter().enumerate() {
+            let shaded = match self.settings.shade_all_hits {
+                true if Some(i) == first => Some(radiance),
+                true => Some(scene.radiance(path, origin, dir, Some(*h), sampler)),
+                false => None,
+            };
+            scratch.slice_hits.push(SliceHit { z: h.t, coverage: geo.coverage(mats, h, dir), radiance: shaded });
+        }
         scratch.acc.add_sample(self.slices, &scratch.slice_hits);
-        scratch.hits.iter().find(|h| geo.accepts(mats, h, key)).copied()
+        if let (false, Some(i)) = (self.settings.shade_all_hits, first) {
+            scratch.acc.add_color(self.slices, scratch.hits[i].t, radiance, 1.0);
+        }
+        radiance
     }
 
     /// HCI semantics: depth of the first surface with coverage ≥ 0.5 on the pixel-centre ray.

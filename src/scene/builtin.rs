@@ -22,7 +22,8 @@ pub fn generate(cfg: &Config, index: u64) -> SceneDesc {
     g.room(size);
     g.lights(size);
     let camera = g.camera(size);
-    let free_z = size.z / 2.0 - 1.3;
+    // Keep the first 2 m in front of the camera free: a pane right at the lens would fill the view.
+    let free_z = size.z / 2.0 - 2.0;
     for _ in 0..s.objects {
         g.furniture(size, free_z);
     }

@@ -10,6 +10,7 @@ use std::path::Path;
 
 use npyz::npz::{NpzArchive, NpzWriter, file_name_from_array_name};
 use npyz::zip::result::ZipError;
+use npyz::zip::{DateTime, write::FileOptions};
 use npyz::{DType, NpyFile, Order, WriteOptions, WriterBuilder};
 
 use crate::error::{Error, Result};
@@ -100,7 +101,9 @@ pub fn write_mpi_npz(path: &Path, mpi: &Mpi) -> Result<()> {
     let shape = [mpi.height, mpi.width, mpi.layers, CHANNELS].map(|n| n as u64);
     let mut npz = NpzWriter::create(path).map_err(io)?;
     let zip = npz.zip_writer();
-    zip.start_file(file_name_from_array_name(KEY), Default::default())
+    // A fixed timestamp (1980-01-01, zip's epoch): the same data must give the same bytes.
+    let options = FileOptions::default().last_modified_time(DateTime::default());
+    zip.start_file(file_name_from_array_name(KEY), options)
         .map_err(|e| io(e.into()))?;
     // npyz writes element by element; buffering keeps that from reaching the compressor.
     let mut array = WriteOptions::new()

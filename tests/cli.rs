@@ -1,0 +1,226 @@
+//! End-to-end tests of the `lfgen` binary: determinism, resume after a kill, shards, re-render,
+//! the HCI files as other tools read them, and clear errors on bad input.
+
+use lfformat::manifest::Manifest;
+use lfformat::pfm::read_pfm;
+use std::collections::BTreeMap;
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// A tiny but complete dataset: every feature on, seconds to render.
+const TINY: &[&str] = &[
+    "--set",
+    "camera.resolution=[40,32]",
+    "--set",
+    "camera.grid=[3,3]",
+    "--set",
+    "render.spp=2",
+    "--set",
+    "scene.objects=10",
+    "--set",
+    "dataset.date=2026-01-01",
+    "--quiet",
+];
+
+fn lfgen(args: &[&str], extra: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_lfgen")).args(args).args(extra).output().expect("lfgen runs")
+}
+
+fn ok(out: Output) -> Output {
+    assert!(out.status.success(), "lfgen failed: {}", String::from_utf8_lossy(&out.stderr));
+    out
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+fn tmp() -> tempfile::TempDir {
+    tempfile::tempdir().expect("temp dir")
+}
+
+/// Every file under `root` (relative path → bytes), excluding run timings.
+fn files(root: &Path) -> BTreeMap<String, Vec<u8>> {
+    let mut out = BTreeMap::new();
+    let mut stack = vec![root.to_path_buf()];
+    while let Some(dir) = stack.pop() {
+        for e in fs::read_dir(&dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.file_name().unwrap() != "timings.jsonl" {
+                out.insert(p.strip_prefix(root).unwrap().display().to_string(), fs::read(&p).unwrap());
+            }
+        }
+    }
+    out
+}
+
+fn generate(out: &Path, scenes: &str, extra: &[&str]) -> Output {
+    let mut args = vec!["--scenes", scenes, "--out", out.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    lfgen(&args, TINY)
+}
+
+#[test]
+fn same_seed_is_byte_identical_across_thread_counts_and_seeds_differ() {
+    let (a, b, c) = (tmp(), tmp(), tmp());
+    ok(generate(a.path(), "2", &["--threads", "1"]));
+    ok(generate(b.path(), "2", &["--threads", "2"]));
+    ok(generate(c.path(), "2", &["--threads", "2", "--seed", "7"]));
+    let (fa, fb, fc) = (files(a.path()), files(b.path()), files(c.path()));
+    assert!(fa.contains_key("train/scene_0000/input_Cam004.png"), "{:?}", fa.keys());
+    assert_eq!(fa.keys().collect::<Vec<_>>(), fb.keys().collect::<Vec<_>>());
+    for (name, bytes) in &fa {
+        assert!(bytes == &fb[name], "{name} differs between 1 and 2 threads");
+    }
+    let view = "train/scene_0000/input_Cam004.png";
+    assert_ne!(fa[view], fc[view], "another seed must give another scene");
+}
+
+#[test]
+fn scene_folder_has_every_hci_and_multimodal_file() {
+    let d = tmp();
+    ok(generate(d.path(), "1", &[]));
+    let scene = d.path().join("train/scene_0000");
+    let mut names: Vec<String> = fs::read_dir(&scene).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
+    names.sort();
+    let mut expected: Vec<String> = (0..9).map(|i| format!("input_Cam{i:03}.png")).collect();
+    expected.extend(
+        ["gt_depth_lowres.pfm", "gt_disp_lowres.pfm", "gt_mpi_lowres.npz", "modes.exr", "parameters.cfg", "scene.json", "stats.json"]
+            .map(String::from),
+    );
+    expected.sort();
+    assert_eq!(names, expected);
+    let manifest = Manifest::read(&d.path().join("manifest.json")).unwrap();
+    assert_eq!(manifest.scenes.len(), 1);
+    assert_eq!(manifest.scenes[0].files.len(), expected.len());
+}
+
+/// A minimal INI reader written here, independent of lfformat's.
+fn ini(path: &Path) -> BTreeMap<String, String> {
+    let mut section = String::new();
+    let mut out = BTreeMap::new();
+    for line in fs::read_to_string(path).unwrap().lines().map(str::trim) {
+        if let Some(s) = line.strip_prefix('[').and_then(|l| l.strip_suffix(']')) {
+            section = s.to_string();
+        } else if let Some((k, v)) = line.split_once('=') {
+            out.insert(format!("{section}.{}", k.trim()), v.trim().to_string());
+        }
+    }
+    out
+}
+
+#[test]
+fn parameters_cfg_formula_reproduces_gt_disp_from_gt_depth() {
+    let d = tmp();
+    ok(generate(d.path(), "1", &[]));
+    let scene = d.path().join("train/scene_0000");
+    let cfg = ini(&scene.join("parameters.cfg"));
+    let f = |k: &str| cfg[k].parse::<f64>().unwrap_or_else(|_| panic!("{k} = {}", cfg[k]));
+    let (w, h) = (f("intrinsics.image_resolution_x_px"), f("intrinsics.image_resolution_y_px"));
+    assert_eq!((w, h), (40.0, 32.0));
+    assert_eq!(f("extrinsics.num_cams_x"), 3.0);
+    let f_px = f("intrinsics.focal_length_mm") * w.max(h) / f("intrinsics.sensor_size_mm");
+    let b = f("extrinsics.baseline_mm") / 1000.0;
+    let zf = f("extrinsics.focus_distance_m");
+    let depth = read_pfm(&scene.join("gt_depth_lowres.pfm")).unwrap();
+    let disp = read_pfm(&scene.join("gt_disp_lowres.pfm")).unwrap();
+    assert_eq!((depth.width, depth.height), (40, 32));
+    for (z, d) in depth.data.iter().zip(&disp.data) {
+        let expected = f_px * b * (1.0 / *z as f64 - 1.0 / zf);
+        assert!((expected - *d as f64).abs() < 1e-4 * expected.abs().max(1.0), "{d} vs {expected}");
+    }
+    // The configured disparity range is met and written with HCI's rounding.
+    let (lo, hi) = (f("meta.disp_min"), f("meta.disp_max"));
+    assert!(lo >= -3.7 && hi <= 3.7 && lo < -1.0 && hi > 1.0, "{lo} {hi}");
+}
+
+#[test]
+fn killed_run_resumes_to_the_same_bytes_and_never_leaves_half_scenes() {
+    let (reference, killed) = (tmp(), tmp());
+    ok(generate(reference.path(), "3", &[]));
+    let out = killed.path().to_str().unwrap();
+    let mut args = vec!["--scenes", "3", "--out", out];
+    args.extend_from_slice(TINY);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lfgen")).args(&args).spawn().unwrap();
+    // Kill it as soon as the first scene is published: later scenes are then in flight.
+    let manifest = killed.path().join("manifest.json");
+    while !manifest.exists() && child.try_wait().unwrap().is_none() {
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    // Whatever was published is complete; partial work only ever sits in hidden folders.
+    if let Ok(m) = Manifest::read(&killed.path().join("manifest.json")) {
+        assert!(m.scenes.iter().all(|e| lfformat::manifest::scene_entry_verifies(killed.path(), e)));
+    }
+    // Damage one published scene by hand as well: resume must redo it.
+    let rerun = generate(killed.path(), "3", &[]);
+    assert!(!rerun.status.success() && stderr(&rerun).contains("--resume"), "{}", stderr(&rerun));
+    ok(generate(killed.path(), "3", &["--resume"]));
+    fs::remove_file(killed.path().join("train/scene_0001/modes.exr")).unwrap();
+    ok(generate(killed.path(), "3", &["--resume"]));
+    let (a, b) = (files(reference.path()), files(killed.path()));
+    assert_eq!(a.keys().collect::<Vec<_>>(), b.keys().collect::<Vec<_>>());
+    assert!(a == b, "resumed dataset differs from an uninterrupted run");
+}
+
+#[test]
+fn shards_merge_into_the_unsharded_dataset() {
+    let (whole, sharded) = (tmp(), tmp());
+    ok(generate(whole.path(), "3", &[]));
+    ok(generate(sharded.path(), "3", &["--shard", "0/2"]));
+    ok(generate(sharded.path(), "3", &["--shard", "1/2"]));
+    assert!(sharded.path().join("manifest.shard-1-of-2.json").exists());
+    ok(lfgen(&["merge", sharded.path().to_str().unwrap()], &[]));
+    let (a, mut b) = (files(whole.path()), files(sharded.path()));
+    b.retain(|k, _| !k.starts_with("manifest.shard-"));
+    assert!(a == b, "merged shards differ from one run");
+}
+
+#[test]
+fn rerendering_scene_json_reproduces_the_scene() {
+    let d = tmp();
+    ok(generate(d.path(), "1", &[]));
+    let scene = d.path().join("train/scene_0000");
+    let again = d.path().join("again");
+    let json = scene.join("scene.json");
+    ok(lfgen(&["render", json.to_str().unwrap(), "--out", again.to_str().unwrap()], TINY));
+    assert!(files(&scene) == files(&again), "re-render differs");
+}
+
+#[test]
+fn bad_input_gives_clear_errors_and_no_scene() {
+    let d = tmp();
+    let out = d.path().join("ds");
+    let o = out.to_str().unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (&["--set", "render.sppp=4"], "render.sppp"),
+        (&["--set", "render.spp=many"], "render"),
+        (&["--set", "camera.grid=[4,4]"], "odd"),
+        (&["--preset", "huge"], "unknown preset"),
+        (&["--shard", "3/2"], "--shard"),
+    ];
+    for (args, needle) in cases {
+        let r = lfgen(&[&["--scenes", "1", "--out", o][..], args].concat(), &["--quiet"]);
+        assert!(!r.status.success() && stderr(&r).contains(needle), "{args:?}: {}", stderr(&r));
+    }
+    let bad_toml = d.path().join("bad.toml");
+    fs::write(&bad_toml, "[render]\nspp = = 3\n").unwrap();
+    let r = lfgen(&["--config", bad_toml.to_str().unwrap(), "--out", o], &["--quiet"]);
+    assert!(!r.status.success() && stderr(&r).contains("bad.toml"), "{}", stderr(&r));
+    let unknown = d.path().join("unknown.toml");
+    fs::write(&unknown, "[render]\nspp = 3\ncolour = true\n").unwrap();
+    let r = lfgen(&["--config", unknown.to_str().unwrap(), "--out", o], &["--quiet"]);
+    assert!(!r.status.success() && stderr(&r).contains("colour"), "{}", stderr(&r));
+    let blocker = d.path().join("file");
+    fs::write(&blocker, "not a folder").unwrap();
+    let under_file: PathBuf = blocker.join("ds");
+    let r = generate(&under_file, "1", &[]);
+    assert!(!r.status.success() && stderr(&r).contains("cannot create output folder"), "{}", stderr(&r));
+    assert!(!out.join("train").exists(), "a failed run must not leave scenes");
+    let r = lfgen(&["render", d.path().join("missing.json").to_str().unwrap(), "--out", o], &[]);
+    assert!(!r.status.success() && stderr(&r).contains("missing.json"), "{}", stderr(&r));
+}
