@@ -200,7 +200,8 @@ fn write_readme(out: &Path, m: &Manifest) -> Result<()> {
          Scenes: {} ({}). Each scene folder is an HCI 4D light-field benchmark scene \
          (`parameters.cfg`, `input_CamNNN.png`, `gt_disp_lowres.pfm`, `gt_depth_lowres.pfm`) plus \
          multimodal ground truth (`modes.exr`, `gt_mpi_lowres.npz`), `scene.json` and `stats.json`.\n\
-         `manifest.json` lists every file with its SHA-256.\n",
+         `manifest.json` lists every file with its SHA-256. `preview.png`: per scene, the centre \
+         view, the HCI disparity, the number of modes with η > 0.3 and η of the front mode.\n",
         m.generator,
         m.version,
         m.seed,
@@ -209,7 +210,9 @@ fn write_readme(out: &Path, m: &Manifest) -> Result<()> {
         splits.join(", ")
     );
     let path = out.join("README.md");
-    fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))
+    fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;
+    let dirs: Vec<String> = m.scenes.iter().map(|e| e.dir.clone()).collect();
+    crate::output::preview::write_preview(out, &dirs)
 }
 
 /// Today's date (UTC) as `YYYY-MM-DD`.

@@ -5,6 +5,7 @@
 //! full disk never leaves a half-written scene under the final name.
 
 pub mod images;
+pub mod preview;
 pub mod scene_dir;
 
 use sha2::{Digest, Sha256};

@@ -37,6 +37,12 @@ impl Sampler {
         Self { rng: Pcg32::new(mix64(key ^ pixel), key | 1), strata: [nx, spp.div_ceil(nx)] }
     }
 
+    /// An independent stream keyed by a 64-bit value (side computations that must not shift
+    /// the pixel's own stream, such as shading hidden slice surfaces).
+    pub fn from_key(key: u64) -> Self {
+        Self { rng: Pcg32::new(mix64(key), mix64(!key) | 1), strata: [1, 1] }
+    }
+
     #[inline]
     pub fn next(&mut self) -> f32 {
         self.rng.random::<f32>()

@@ -173,7 +173,8 @@ impl PixelCtx<'_> {
         for (i, h) in scratch.hits.iter().enumerate() {
             let shaded = match self.settings.shade_all_hits {
                 true if Some(i) == first => Some(radiance),
-                true => Some(scene.radiance(path, origin, dir, Some(*h), sampler)),
+                // Hidden surfaces draw from their own stream so the colour image stays the same.
+                true => Some(scene.radiance(path, origin, dir, Some(*h), &mut Sampler::from_key(key ^ i as u64))),
                 false => None,
             };
             scratch.slice_hits.push(SliceHit { z: h.t, coverage: geo.coverage(mats, h, dir), radiance: shaded });

@@ -63,7 +63,11 @@ pub fn matte(color: [f32; 3], opacity: f32) -> Material {
 
 /// An opaque emitter (area light).
 pub fn emitter(emission: [f32; 3]) -> Material {
-    Material { name: "light".into(), emission, ..matte([0.8; 3], 1.0) }
+    Material {
+        name: "light".into(),
+        emission,
+        ..matte([0.8; 3], 1.0)
+    }
 }
 
 /// A shape, where it is, and what it is made of.
@@ -75,12 +79,20 @@ pub struct Part {
 
 /// A `w × h` rectangle facing +Z (towards the camera), centred at `centre`.
 pub fn quad(size: [f32; 2], centre: Vec3, material: Material) -> Part {
-    Part { shape: Shape::Quad { size }, transform: Transform::at(centre), material }
+    Part {
+        shape: Shape::Quad { size },
+        transform: Transform::at(centre),
+        material,
+    }
 }
 
 /// An axis-aligned box centred at `centre`.
 pub fn cuboid(size: Vec3, centre: Vec3, material: Material) -> Part {
-    Part { shape: Shape::Cuboid { size }, transform: Transform::at(centre), material }
+    Part {
+        shape: Shape::Cuboid { size },
+        transform: Transform::at(centre),
+        material,
+    }
 }
 
 /// A scene from its camera, the GT depth range, the environment radiance and its parts.
@@ -90,12 +102,22 @@ pub fn scene(
     environment: [f32; 3],
     parts: Vec<Part>,
 ) -> SceneDesc {
-    let slices = SliceRange { z_near, z_far, count: SLICES, spacing: SliceSpacing::Depth };
+    let slices = SliceRange {
+        z_near,
+        z_far,
+        count: SLICES,
+        spacing: SliceSpacing::Depth,
+    };
     let (mut materials, mut objects) = (Vec::new(), Vec::new());
     for (i, p) in parts.into_iter().enumerate() {
         materials.push(p.material);
         let name = format!("part{i}");
-        objects.push(Object { name, shape: p.shape, transform: p.transform, material: i as u32 });
+        objects.push(Object {
+            name,
+            shape: p.shape,
+            transform: p.transform,
+            material: i as u32,
+        });
     }
     SceneDesc {
         generator: "analytic tests".into(),
@@ -114,7 +136,10 @@ pub fn scene(
 /// Render settings; Russian roulette is pushed past `max_depth` so path weights stay exact.
 pub fn settings(spp: u32, max_depth: u32) -> RenderSettings {
     RenderSettings {
-        path: PathSettings { max_depth, rr_depth: max_depth + 1 },
+        path: PathSettings {
+            max_depth,
+            rr_depth: max_depth + 1,
+        },
         spp,
         seed: 11,
         scene_index: 0,
@@ -137,6 +162,7 @@ impl Harness {
 
     pub fn render(&self, view: u32, settings: &RenderSettings, with_gt: bool) -> ViewOutput {
         let (cam, slices) = (&self.desc.camera, &self.desc.slices);
-        self.scene.render_view(cam, slices, settings, view, with_gt, &AtomicU64::new(0))
+        self.scene
+            .render_view(cam, slices, settings, view, with_gt, &AtomicU64::new(0))
     }
 }

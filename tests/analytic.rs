@@ -1,0 +1,592 @@
+//! Renders of scenes whose images and depth ground truth are known in closed form, checked
+//! against formulas (SPEC §2–3) rather than against the renderer's own output.
+
+mod common;
+
+use common::{
+    Harness, Part, camera, cuboid, disparity, emitter, f_px, matte, quad, scene, settings,
+};
+use glam::{DVec3, Quat, Vec3};
+use lfformat::{Mode, ModeMap};
+use lfgen::camera::LightFieldCamera;
+use lfgen::output::images::{linear_to_srgb, to_srgb8};
+use lfgen::render::view::ViewGt;
+use lfgen::scene::{Material, SceneDesc, Shape, SurfaceModel, Texture, Transform};
+
+/// Centre camera of the fronto-parallel scenes: planes at world z = 4 − depth.
+const EYE: DVec3 = DVec3::new(0.0, 1.0, 4.0);
+
+/// World-space centre of a point at planar `depth` straight ahead of [`EYE`], offset in x, y.
+fn ahead(depth: f64, dx: f64, dy: f64) -> Vec3 {
+    (EYE + DVec3::new(dx, dy, -depth)).as_vec3()
+}
+
+fn gt(out: lfgen::render::view::ViewOutput) -> ViewGt {
+    out.gt.expect("ground truth was requested")
+}
+
+/// Checks one mode against a surface at planar `depth` contributing `eta` by both definitions.
+fn assert_mode(m: &Mode, cam: &LightFieldCamera, depth: f64, eta: f32, tol: f32, at: &str) {
+    let rel = (m.depth as f64 - depth).abs() / depth;
+    assert!(rel < 1e-4, "{at}: depth {} vs {depth}", m.depth);
+    let d = disparity(cam, depth);
+    // 1e-4 px: f32 depth error (~1e-7 relative) moves d by far less than that.
+    assert!(
+        (m.disparity as f64 - d).abs() < 1e-4,
+        "{at}: disparity {} vs {d}",
+        m.disparity
+    );
+    assert!((m.eta - eta).abs() < tol, "{at}: eta {} vs {eta}", m.eta);
+    assert!(
+        (m.eta_exact - eta).abs() < tol,
+        "{at}: eta_exact {} vs {eta}",
+        m.eta_exact
+    );
+}
+
+fn pixels(map: &ModeMap) -> impl Iterator<Item = (usize, usize)> + use<> {
+    let (w, h) = (map.width, map.height);
+    (0..h).flat_map(move |y| (0..w).map(move |x| (x, y)))
+}
+
+// ---------------------------------------------------------------------------------------
+// 1. A fronto-parallel checker plane.
+// ---------------------------------------------------------------------------------------
+
+/// Plane depth, its disparity (an integer, so views are integer shifts of each other), and the
+/// checker cell width in pixels.
+const PLANE_Z: f64 = 2.0;
+const PLANE_D: i32 = 2;
+const CELL_PX: i32 = 4;
+/// Cells from the plane's centre to its edge: 48 px, more than the 32 px half image plus the
+/// 4 px shift of a corner view of the 5×5 grid, so every view sees only the plane.
+const HALF_CELLS: i32 = 12;
+const CHECKER: [[f32; 3]; 2] = [[0.8, 0.1, 0.3], [0.1, 0.6, 0.05]];
+
+/// A smooth metal with the checker as its colour under a white environment.
+///
+/// Why not a diffuse plane: the Standard BSDF puts a GGX glossy layer over the Lambert base,
+/// so a "diffuse" surface reflects `E(μ) + c·(1 − E(μ))` of a constant environment, which
+/// depends on the view angle, and its one-sample estimate is noisy. A metal at the minimum
+/// roughness (α = 1e-3) reflects `F(wo·h)·G2/G1 ≈ F0 = base colour` per sample: within 14° of
+/// the axis the Schlick term `(1 − cos)^5` is below 3e-8 and Λ below 1e-7, so every sample
+/// of a pixel inside one cell returns the same radiance to f32 precision.
+fn checker_plane() -> SceneDesc {
+    let mut cam = camera([64, 64], [5, 5], 100.0, EYE);
+    // 1/Zf = 1/Z − d/(f·b) makes the plane's disparity exactly PLANE_D.
+    let inv_zf = 1.0 / PLANE_Z - PLANE_D as f64 / (f_px(&cam) * cam.baseline_m);
+    cam.focus_distance_m = 1.0 / inv_zf;
+    let cell = (CELL_PX as f64 * PLANE_Z / f_px(&cam)) as f32;
+    let [a, b] = CHECKER;
+    let mirror = Material {
+        base_color: Texture::Checker { a, b, size: cell },
+        roughness: 0.0,
+        metallic: 1.0,
+        ..matte([1.0; 3], 1.0)
+    };
+    // Centred on the optical axis, so a cell corner (UV multiple of `cell`) projects to the
+    // principal point (32, 32), a pixel corner; cell edges then fall on pixel boundaries.
+    let size = 2.0 * HALF_CELLS as f32 * cell;
+    let plane = quad([size, size], ahead(PLANE_Z, 0.0, 0.0), mirror);
+    scene(cam, [1.0, 5.0], [1.0; 3], vec![plane])
+}
+
+/// The checker colour of centre-view pixel `(i, j)`, from where its centre lands on the plane.
+fn expected_checker(i: i32, j: i32, width: i32, height: i32) -> [f32; 3] {
+    // Image x grows with world x; image y grows against world y (and against UV v).
+    let cu = (2 * i + 1 - width).div_euclid(2 * CELL_PX);
+    let cv = (height - 2 * j - 1).div_euclid(2 * CELL_PX);
+    CHECKER[(cu + cv).rem_euclid(2) as usize]
+}
+
+/// Guards the choice of colours: an 8-bit code that sits near a rounding boundary could flip
+/// on an f32 rounding of the radiance, which would make the exact comparisons meaningless.
+fn assert_far_from_rounding(colors: &[[f32; 3]]) {
+    for v in colors.iter().flatten() {
+        let code = linear_to_srgb(*v) * 255.0;
+        assert!(
+            (code.fract() - 0.5).abs() > 0.05,
+            "{v} encodes to {code}, too near .5"
+        );
+    }
+}
+
+/// Every view's GT: one opaque surface at the plane's depth and integer disparity.
+fn assert_plane_gt(cam: &LightFieldCamera, g: &ViewGt) {
+    assert!((disparity(cam, PLANE_Z) - PLANE_D as f64).abs() < 1e-9);
+    assert_every_pixel(cam, g, &[(PLANE_Z, 1.0)], 1e-6);
+    assert_hci(g, PLANE_Z);
+}
+
+/// An 8-bit sRGB view.
+struct Srgb {
+    bytes: Vec<u8>,
+    w: i32,
+    h: i32,
+}
+
+impl Srgb {
+    fn px(&self, i: i32, j: i32) -> &[u8] {
+        let k = 3 * (j * self.w + i) as usize;
+        &self.bytes[k..k + 3]
+    }
+}
+
+/// Pixels of one view allowed to differ from the truth.
+///
+/// A render is exact up to two rare f32/sampling effects, each ~1e-6 per sample:
+/// - a sample position is `x as f32 + offset` (~4e-6 px resolution at x ≈ 60), and the hit
+///   and its UV add ~1e-6 px, so a sample that close to a cell edge may read the other cell;
+/// - the α = 1e-3 GGX lobe has long tails: a rare half vector far from the normal changes
+///   the Fresnel term, or reflects below the horizon, which ends the path black.
+///
+/// Over 41 seeds × 25 views at 1 spp, two pixels in all differed; a wrong shift or checker
+/// phase breaks hundreds of pixels per view.
+const MAX_OUTLIERS: usize = 3;
+
+/// Counts differing pixel pairs and describes the first.
+#[derive(Default)]
+struct Diffs {
+    count: usize,
+    first: Option<String>,
+}
+
+impl Diffs {
+    fn check(&mut self, got: &[u8], want: &[u8], at: impl FnOnce() -> String) {
+        if got != want {
+            self.count += 1;
+            self.first
+                .get_or_insert_with(|| format!("{}: {got:?} vs {want:?}", at()));
+        }
+    }
+
+    fn assert_few(&self, what: &str) {
+        let n = self.count;
+        assert!(
+            n <= MAX_OUTLIERS,
+            "{what}: {n} pixels differ, first {:?}",
+            self.first
+        );
+    }
+}
+
+/// The centre view shows the analytic checker, pixel for pixel.
+fn assert_centre_is_checker(img: &Srgb) {
+    let (mut seen, mut diffs) = ([0usize; 2], Diffs::default());
+    for (j, i) in (0..img.h).flat_map(|j| (0..img.w).map(move |i| (j, i))) {
+        let c = expected_checker(i, j, img.w, img.h);
+        seen[usize::from(c != CHECKER[0])] += 1;
+        let want = to_srgb8(&[Vec3::from(c)], 1.0);
+        diffs.check(img.px(i, j), &want, || format!("pixel ({i}, {j})"));
+    }
+    diffs.assert_few("centre view");
+    // Not a constant image: both colours cover large areas, so a shift is detectable.
+    assert!(seen[0] > 1000 && seen[1] > 1000, "{seen:?}");
+}
+
+/// View `(u, v)` equals the centre view shifted by `(u−uc, v−vc)·d`, wherever that stays inside.
+fn assert_shifted(view: &Srgb, centre: &Srgb, (du, dv): (i32, i32)) {
+    let (w, h) = (view.w, view.h);
+    let (mut compared, mut diffs) = (0, Diffs::default());
+    for (j, i) in (0..h).flat_map(|j| (0..w).map(move |i| (j, i))) {
+        let (ci, cj) = (i + du * PLANE_D, j + dv * PLANE_D);
+        if (0..w).contains(&ci) && (0..h).contains(&cj) {
+            diffs.check(view.px(i, j), centre.px(ci, cj), || {
+                format!("pixel ({i}, {j})")
+            });
+            compared += 1;
+        }
+    }
+    diffs.assert_few(&format!("view ({du}, {dv})"));
+    assert!(
+        compared >= (w - 8) * (h - 8),
+        "only {compared} pixels overlap"
+    );
+}
+
+#[test]
+fn fronto_parallel_plane_disparity_and_view_shift() {
+    assert_far_from_rounding(&CHECKER);
+    let h = Harness::new(checker_plane());
+    let cam = &h.desc.camera;
+    // One sample per pixel suffices: a pixel's footprint lies inside one cell, so its value
+    // does not depend on where the sample falls.
+    let s = settings(1, 2);
+    let render = |view| {
+        let out = h.render(view, &s, true);
+        let (w, h) = (out.image.width as i32, out.image.height as i32);
+        let img = Srgb {
+            bytes: to_srgb8(&out.image.pixels, 1.0),
+            w,
+            h,
+        };
+        assert_plane_gt(cam, &gt(out));
+        img
+    };
+    let centre = render(cam.center_view());
+    assert_centre_is_checker(&centre);
+    for view in (0..cam.num_views()).filter(|&v| v != cam.center_view()) {
+        assert_shifted(&render(view), &centre, cam.view_offset(view));
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// 2. A semi-transparent pane over a wall.
+// ---------------------------------------------------------------------------------------
+
+const PANE_Z: f64 = 1.5;
+const WALL_Z: f64 = 3.5;
+
+/// A pane of the given opacity at [`PANE_Z`] in front of an opaque wall at [`WALL_Z`], both
+/// covering the whole view; the centre view's ground truth.
+fn pane_over_wall(opacity: f32) -> (LightFieldCamera, ViewGt) {
+    let cam = camera([24, 24], [5, 5], 100.0, EYE);
+    let pane = quad(
+        [4.0, 4.0],
+        ahead(PANE_Z, 0.0, 0.0),
+        matte([0.9; 3], opacity),
+    );
+    let wall = quad([8.0, 8.0], ahead(WALL_Z, 0.0, 0.0), matte([0.5; 3], 1.0));
+    let h = Harness::new(scene(cam.clone(), [1.0, 5.0], [1.0; 3], vec![pane, wall]));
+    let out = h.render(cam.center_view(), &settings(4, 1), true);
+    (cam, gt(out))
+}
+
+/// Every pixel has exactly the given modes `(depth, η)`, η within `tol`.
+fn assert_every_pixel(cam: &LightFieldCamera, g: &ViewGt, want: &[(f64, f32)], tol: f32) {
+    for (x, y) in pixels(&g.modes) {
+        let modes = g.modes.pixel(x, y);
+        let at = format!("pixel ({x}, {y})");
+        assert_eq!(modes.len(), want.len(), "{at}: {modes:?}");
+        for (m, &(depth, eta)) in modes.iter().zip(want) {
+            assert_mode(m, cam, depth, eta, tol, &at);
+        }
+    }
+}
+
+/// Every pixel's HCI depth (pixel-centre ray) is `depth`.
+fn assert_hci(g: &ViewGt, depth: f64) {
+    for (i, &got) in g.hci_depth.iter().enumerate() {
+        let rel = (got as f64 - depth).abs() / depth;
+        assert!(rel < 1e-4, "pixel {i}: hci depth {got} vs {depth}");
+    }
+}
+
+#[test]
+fn pane_over_wall_two_modes() {
+    // η = α of the pane, then (1 − α)·1 for the wall; the HCI depth is the first surface with
+    // coverage ≥ 0.5.
+    let (cam, g) = pane_over_wall(0.4);
+    assert_every_pixel(&cam, &g, &[(PANE_Z, 0.4), (WALL_Z, 0.6)], 1e-3);
+    assert_hci(&g, WALL_Z);
+    // A fully transparent pane contributes nothing and is no mode.
+    let (cam, g) = pane_over_wall(0.0);
+    assert_every_pixel(&cam, &g, &[(WALL_Z, 1.0)], 1e-3);
+    assert_hci(&g, WALL_Z);
+    // An opaque pane hides the wall completely: the wall is no mode either.
+    let (cam, g) = pane_over_wall(1.0);
+    assert_every_pixel(&cam, &g, &[(PANE_Z, 1.0)], 1e-3);
+    assert_hci(&g, PANE_Z);
+}
+
+// ---------------------------------------------------------------------------------------
+// 3. An opaque edge through a column of pixels.
+// ---------------------------------------------------------------------------------------
+
+/// The occluder's right edge projects to x = 20.3 in the centre view: pixel column 20 is
+/// covered 30 % (from its left side). In view (u, v) it moves to 20.3 − (u − uc)·d.
+const EDGE_X: f64 = 20.3;
+const OCCLUDER_Z: f64 = 2.0;
+const BACK_Z: f64 = 4.0;
+
+/// An opaque quad left of the edge at [`OCCLUDER_Z`], a wall at [`BACK_Z`] behind it.
+fn occluder_edge() -> Harness {
+    let cam = camera([64, 64], [5, 5], 100.0, EYE);
+    let half_w = cam.width() as f64 / 2.0;
+    let edge = (EDGE_X - half_w) * OCCLUDER_Z / f_px(&cam);
+    let black = matte([0.2; 3], 1.0);
+    let occluder = quad([2.0, 4.0], ahead(OCCLUDER_Z, edge - 1.0, 0.0), black);
+    let wall = quad([8.0, 8.0], ahead(BACK_Z, 0.0, 0.0), matte([0.7; 3], 1.0));
+    Harness::new(scene(cam, [1.0, 5.0], [1.0; 3], vec![occluder, wall]))
+}
+
+/// Largest possible error of the covered fraction of a pixel cut at `f` by a vertical edge,
+/// with 64 samples in 8 × 8 jittered strata: stratum columns left of the edge are always
+/// covered, those right of it never; only the 8 samples of the column holding the edge are
+/// random, each covered with p = frac(8f). The count is then fixed + B(8, p), and the error
+/// at most 8·max(p, 1 − p)/64 ≤ 0.125 whatever the jitter (0.075 for f = 0.3).
+fn edge_bound(f: f64) -> f32 {
+    let p = (8.0 * f).fract();
+    (8.0 * p.max(1.0 - p) / 64.0) as f32 + 1e-4
+}
+
+/// The mean over a column of 64 pixels has σ ≤ √(8·¼)/64/8 ≈ 0.0028; 0.02 is over 7σ.
+const EDGE_MEAN_TOL: f32 = 0.02;
+
+#[test]
+fn occluder_edge_fraction() {
+    let h = occluder_edge();
+    let cam = &h.desc.camera;
+    // The centre view (edge at 20.3), and side views where it moves by ∓2·1.52 px.
+    for view in [cam.center_view(), 0, 14] {
+        let edge = EDGE_X - cam.view_offset(view).0 as f64 * disparity(cam, OCCLUDER_Z);
+        let g = gt(h.render(view, &settings(64, 1), true));
+        let mean = assert_edge_view(cam, &g, edge, &format!("view {view}"));
+        let f = edge.fract() as f32;
+        assert!(
+            (mean - f).abs() < EDGE_MEAN_TOL,
+            "view {view}: column mean {mean} vs {f}"
+        );
+    }
+}
+
+/// Checks every pixel against an edge at image x = `edge`; returns the edge column's mean η.
+fn assert_edge_view(cam: &LightFieldCamera, g: &ViewGt, edge: f64, what: &str) -> f32 {
+    let (col, f) = (edge.floor() as usize, edge.fract());
+    let mut sum = 0.0;
+    for (x, y) in pixels(&g.modes) {
+        let modes = g.modes.pixel(x, y);
+        let at = format!("{what} pixel ({x}, {y})");
+        if x == col {
+            sum += assert_edge_pixel(cam, modes, f, &at);
+            continue;
+        }
+        // Fully covered pixels see only the occluder; uncovered ones only the wall.
+        let depth = if x < col { OCCLUDER_Z } else { BACK_Z };
+        assert_eq!(modes.len(), 1, "{at}: {modes:?}");
+        assert_mode(&modes[0], cam, depth, 1.0, 1e-6, &at);
+    }
+    sum / g.modes.height as f32
+}
+
+/// An edge pixel: the occluder with η ≈ f, then the wall with the rest. Returns the front η.
+fn assert_edge_pixel(cam: &LightFieldCamera, modes: &[Mode], f: f64, at: &str) -> f32 {
+    assert_eq!(modes.len(), 2, "{at}: {modes:?}");
+    let front = modes[0].eta;
+    assert_mode(&modes[0], cam, OCCLUDER_Z, f as f32, edge_bound(f), at);
+    // Whatever the sampled coverage, the wall fills the rest of the pixel exactly.
+    assert_mode(&modes[1], cam, BACK_Z, 1.0 - front, 1e-5, at);
+    assert!((modes[0].eta_exact - front).abs() < 1e-6, "{at}: {modes:?}");
+    front
+}
+
+// ---------------------------------------------------------------------------------------
+// 4. A closed room.
+// ---------------------------------------------------------------------------------------
+
+/// Room `[-2, 2] × [0, 3] × [-3, 3]`; the camera stands at z = 2, so the back wall is at
+/// planar depth 5.
+const ROOM: Vec3 = Vec3::new(4.0, 3.0, 6.0);
+const ROOM_EYE: DVec3 = DVec3::new(0.0, 1.5, 2.0);
+const ROOM_BACK_Z: f64 = 5.0;
+
+/// The room with two semi-transparent panes (one slanted across many slices), an opaque box
+/// on the floor and a ceiling light, seen through a wide lens so floor, ceiling and side walls
+/// are in view.
+fn room() -> SceneDesc {
+    let cam = camera([48, 48], [5, 5], 20.0, ROOM_EYE);
+    let slanted = Transform::at(Vec3::new(0.3, 1.2, -0.5)).rotated_y(0.6);
+    let ceiling = Transform {
+        rotation: Quat::from_rotation_x(std::f32::consts::FRAC_PI_2),
+        ..Transform::at(Vec3::new(0.0, 2.99, -1.0))
+    };
+    let parts = vec![
+        Part {
+            shape: Shape::Room { size: ROOM },
+            transform: Transform::at(Vec3::ZERO),
+            material: matte([0.7; 3], 1.0),
+        },
+        quad(
+            [1.5, 1.2],
+            Vec3::new(-0.4, 1.4, 0.5),
+            matte([0.9, 0.3, 0.3], 0.3),
+        ),
+        Part {
+            shape: Shape::Quad { size: [1.4, 1.6] },
+            transform: slanted,
+            material: matte([0.3, 0.3, 0.9], 0.5),
+        },
+        cuboid(
+            Vec3::new(0.6, 0.8, 0.6),
+            Vec3::new(0.5, 0.4, -1.5),
+            matte([0.4, 0.8, 0.4], 1.0),
+        ),
+        Part {
+            shape: Shape::Quad { size: [1.0, 1.0] },
+            transform: ceiling,
+            material: emitter([5.0; 3]),
+        },
+    ];
+    scene(cam, [1.0, 5.2], [0.0; 3], parts)
+}
+
+/// Pixels whose whole footprint sees the back wall (its projection is a rectangle).
+fn inside_back_wall(cam: &LightFieldCamera, x: usize, y: usize) -> bool {
+    let f = f_px(cam);
+    let half = ROOM / 2.0;
+    let to_px = |metres: f64, centre: u32| centre as f64 / 2.0 + f * metres / ROOM_BACK_Z;
+    let (x0, x1) = (
+        to_px(-half.x as f64, cam.width()),
+        to_px(half.x as f64, cam.width()),
+    );
+    // Image y grows downwards: the ceiling (1.5 m above the eye) is at the top.
+    let up = ROOM.y as f64 - ROOM_EYE.y;
+    let (y0, y1) = (to_px(-up, cam.height()), to_px(ROOM_EYE.y, cam.height()));
+    x as f64 >= x0 && (x + 1) as f64 <= x1 && y as f64 >= y0 && (y + 1) as f64 <= y1
+}
+
+fn assert_sorted_and_finite(modes: &[Mode], at: &str) {
+    for m in modes {
+        assert!(
+            m.disparity.is_finite() && m.depth.is_finite(),
+            "{at}: {m:?}"
+        );
+        assert!(
+            (0.0..=1.0).contains(&m.eta) && (0.0..=1.0).contains(&m.eta_exact),
+            "{at}: {m:?}"
+        );
+    }
+    for pair in modes.windows(2) {
+        assert!(
+            pair[0].depth < pair[1].depth,
+            "{at}: depths not increasing: {modes:?}"
+        );
+        // Non-strict: two modes just either side of a slice boundary may round to one f32.
+        assert!(
+            pair[0].disparity >= pair[1].disparity,
+            "{at}: disparities: {modes:?}"
+        );
+    }
+}
+
+#[test]
+fn closed_room_eta_sums_to_one_and_modes_sorted() {
+    let h = Harness::new(room());
+    let cam = &h.desc.camera;
+    let g = gt(h.render(cam.center_view(), &settings(16, 2), true));
+    let mut back_wall_pixels = 0;
+    for (x, y) in pixels(&g.modes) {
+        let modes = g.modes.pixel(x, y);
+        let at = format!("pixel ({x}, {y})");
+        assert_sorted_and_finite(modes, &at);
+        // Per sample the hits' T·a add up to 1 once an opaque surface is reached, and every
+        // ray in a closed room reaches one.
+        let exact: f32 = modes.iter().map(|m| m.eta_exact).sum();
+        assert!(
+            (exact - 1.0).abs() < 1e-3,
+            "{at}: Σ η_exact = {exact}: {modes:?}"
+        );
+        // The over operator gives Σ η = 1 − Π(1 − α_k): never above 1, and exactly 1 where
+        // one slice is opaque in every sample — the back wall, at one depth, behind
+        // everything else in its rectangle.
+        let eta: f32 = modes.iter().map(|m| m.eta).sum();
+        assert!(eta < 1.0 + 1e-4, "{at}: Σ η = {eta}");
+        if inside_back_wall(cam, x, y) {
+            back_wall_pixels += 1;
+            assert!((eta - 1.0).abs() < 1e-3, "{at}: Σ η = {eta}: {modes:?}");
+        }
+    }
+    assert!(back_wall_pixels > 300, "{back_wall_pixels}");
+}
+
+// ---------------------------------------------------------------------------------------
+// 5. Thin glass.
+// ---------------------------------------------------------------------------------------
+
+const GLASS_IOR: f32 = 1.5;
+const GLASS_THICKNESS: f64 = 0.01;
+const GLASS_TOL: f32 = 3e-4;
+
+/// The GT of a 1 cm glass slab centred at planar depth `centre` in front of a wall at
+/// [`WALL_Z`], with slices [1, 5] (boundaries every 1/32 m, one at exactly 2.0).
+fn glass_slab(centre: f64) -> (LightFieldCamera, ViewGt) {
+    // 16 px at 100 mm: rays stay within 14° of the axis.
+    let cam = camera([16, 16], [5, 5], 100.0, EYE);
+    let glass = Material {
+        model: SurfaceModel::Glass { ior: GLASS_IOR },
+        ..matte([1.0; 3], 1.0)
+    };
+    let size = Vec3::new(4.0, 4.0, GLASS_THICKNESS as f32);
+    let slab = cuboid(size, ahead(centre, 0.0, 0.0), glass);
+    let wall = quad([8.0, 8.0], ahead(WALL_Z, 0.0, 0.0), matte([0.5; 3], 1.0));
+    let h = Harness::new(scene(cam.clone(), [1.0, 5.0], [1.0; 3], vec![slab, wall]));
+    let out = h.render(cam.center_view(), &settings(4, 1), true);
+    (cam, gt(out))
+}
+
+/// Normal-incidence Fresnel reflectance ((n − 1)/(n + 1))² = 0.04. Within 14° of the normal
+/// the exact unpolarised value rises by less than 1e-4 (0.04008 at 15°), which moves the
+/// composited η by less than 2e-4: the tolerance [`GLASS_TOL`].
+fn fresnel_normal() -> f32 {
+    ((GLASS_IOR - 1.0) / (GLASS_IOR + 1.0)).powi(2)
+}
+
+#[test]
+fn glass_coverage_is_fresnel() {
+    let r = fresnel_normal();
+    let (z1, z2) = (2.0 - GLASS_THICKNESS / 2.0, 2.0 + GLASS_THICKNESS / 2.0);
+    // The faces straddle the slice boundary at 2.0: each face is its own mode with the
+    // Fresnel coverage; the back face is seen through the front one.
+    let (cam, g) = glass_slab(2.0);
+    let straddling = [(z1, r), (z2, r * (1.0 - r)), (WALL_Z, (1.0 - r).powi(2))];
+    assert_every_pixel(&cam, &g, &straddling, GLASS_TOL);
+    // Shifted to the middle of slice 32 ([2.0, 2.03125]): both faces composite into one mode
+    // of α = 1 − (1 − R)², at their over-weighted mean depth.
+    let mid = 2.0 + 1.0 / 64.0;
+    let (z1, z2) = (mid - GLASS_THICKNESS / 2.0, mid + GLASS_THICKNESS / 2.0);
+    let alpha = 1.0 - (1.0 - r).powi(2);
+    let depth = (r as f64 * z1 + (r * (1.0 - r)) as f64 * z2) / alpha as f64;
+    let (cam, g) = glass_slab(mid);
+    assert_every_pixel(
+        &cam,
+        &g,
+        &[(depth, alpha), (WALL_Z, (1.0 - r).powi(2))],
+        GLASS_TOL,
+    );
+}
+
+// ---------------------------------------------------------------------------------------
+// 6. The GT pass leaves the colour untouched.
+// ---------------------------------------------------------------------------------------
+
+fn bits(out: &lfgen::render::view::ViewOutput) -> Vec<[u32; 3]> {
+    out.image
+        .pixels
+        .iter()
+        .map(|p| p.to_array().map(f32::to_bits))
+        .collect()
+}
+
+#[test]
+fn gt_and_colour_only_render_identical_images() {
+    let h = Harness::new(room());
+    // Deep paths with Russian roulette, NEE and stochastic transparency: every random
+    // decision of the colour path is exercised.
+    let mut s = settings(4, 6);
+    s.path.rr_depth = 2;
+    for view in [0, h.desc.camera.center_view()] {
+        let with = h.render(view, &s, true);
+        let without = h.render(view, &s, false);
+        assert!(with.gt.is_some() && without.gt.is_none());
+        assert!(
+            bits(&with) == bits(&without),
+            "view {view}: colour differs with GT"
+        );
+    }
+}
+
+/// With `shade_all_hits` (true slice colours) the hidden surfaces are shaded from their own
+/// random streams, so the colour image is the same as without GT.
+#[test]
+fn gt_with_shaded_slices_renders_identical_images() {
+    let h = Harness::new(room());
+    let mut s = settings(4, 6);
+    s.shade_all_hits = true;
+    let view = h.desc.camera.center_view();
+    let with = h.render(view, &s, true);
+    let without = h.render(view, &s, false);
+    assert!(
+        bits(&with) == bits(&without),
+        "colour differs when every GT hit is shaded"
+    );
+}
