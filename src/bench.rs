@@ -27,13 +27,21 @@ pub fn run(cfg: &Config) -> Result<()> {
         cfg.render.max_depth
     );
     let rays = cam.view_rays(cam.center_view());
-    let pixels: Vec<(u32, u32)> = (0..BENCH_RES).flat_map(|y| (0..BENCH_RES).map(move |x| (x, y))).collect();
+    let pixels: Vec<(u32, u32)> = (0..BENCH_RES)
+        .flat_map(|y| (0..BENCH_RES).map(move |x| (x, y)))
+        .collect();
     let reps = 8;
     let closest = time(|| {
         pixels.par_iter().for_each(|&(x, y)| {
             let r = rays.ray(x as f32 + 0.5, y as f32 + 0.5);
             for k in 0..reps {
-                std::hint::black_box(scene.geometry.closest(&scene.materials, r.origin, r.dir, f32::INFINITY, k));
+                std::hint::black_box(scene.geometry.closest(
+                    &scene.materials,
+                    r.origin,
+                    r.dir,
+                    f32::INFINITY,
+                    k,
+                ));
             }
         })
     });
@@ -41,19 +49,38 @@ pub fn run(cfg: &Config) -> Result<()> {
         pixels.par_iter().for_each_init(Vec::new, |hits, &(x, y)| {
             let r = rays.ray(x as f32 + 0.5, y as f32 + 0.5);
             for _ in 0..reps {
-                scene.geometry.all_hits(r.origin, r.dir, f32::INFINITY, hits);
+                scene
+                    .geometry
+                    .all_hits(r.origin, r.dir, f32::INFINITY, hits);
                 std::hint::black_box(hits.len());
             }
         })
     });
     let n = (pixels.len() * reps as usize) as f64;
-    println!("closest hit (stochastic opacity): {:.2} Mrays/s", n / closest / 1e6);
-    println!("all hits (anyhit + sort + dedupe): {:.2} Mrays/s", n / all / 1e6);
+    println!(
+        "closest hit (stochastic opacity): {:.2} Mrays/s",
+        n / closest / 1e6
+    );
+    println!(
+        "all hits (anyhit + sort + dedupe): {:.2} Mrays/s",
+        n / all / 1e6
+    );
     println!("all_hits_cost_ratio: {:.3}", all / closest);
     let job = RenderJob::from_config(&cfg, "");
     let settings = job.settings(&desc);
     let counter = AtomicU64::new(0);
-    let render = |gt: bool| time(|| drop(scene.render_view(cam, &desc.slices, &settings, cam.center_view(), gt, &counter)));
+    let render = |gt: bool| {
+        time(|| {
+            drop(scene.render_view(
+                cam,
+                &desc.slices,
+                &settings,
+                cam.center_view(),
+                gt,
+                &counter,
+            ))
+        })
+    };
     // Alternate and keep the best of three to damp the noise of a shared machine.
     let (mut colour, mut with_gt) = (f64::INFINITY, f64::INFINITY);
     for _ in 0..3 {
@@ -61,8 +88,17 @@ pub fn run(cfg: &Config) -> Result<()> {
         with_gt = with_gt.min(render(true));
     }
     let samples = (pixels.len() as u64 * cfg.render.spp as u64) as f64;
-    println!("colour only: {:.3} s ({:.0} camera samples/s)", colour, samples / colour);
-    println!("colour + {}-slice GT: {:.3} s ({:.0} camera samples/s)", cfg.render.slices, with_gt, samples / with_gt);
+    println!(
+        "colour only: {:.3} s ({:.0} camera samples/s)",
+        colour,
+        samples / colour
+    );
+    println!(
+        "colour + {}-slice GT: {:.3} s ({:.0} camera samples/s)",
+        cfg.render.slices,
+        with_gt,
+        samples / with_gt
+    );
     println!("gt_overhead_ratio: {:.3}", with_gt / colour);
     Ok(())
 }

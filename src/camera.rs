@@ -98,10 +98,14 @@ impl LightFieldCamera {
         let shift_x = du as f64 * self.baseline_m / self.focus_distance_m;
         let shift_y = -dv as f64 * self.baseline_m / self.focus_distance_m;
         let o = self.view_origin(view);
-        let half = [self.resolution[0] as f64 / 2.0, self.resolution[1] as f64 / 2.0];
+        let half = [
+            self.resolution[0] as f64 / 2.0,
+            self.resolution[1] as f64 / 2.0,
+        ];
         // dir(x, y) = forward + right·((x - cx)/f - sx) + up·(-(y - cy)/f - sy)
         let right = self.right();
-        let base = self.forward - right * (half[0] / f + shift_x) + self.up * (half[1] / f - shift_y);
+        let base =
+            self.forward - right * (half[0] / f + shift_x) + self.up * (half[1] / f - shift_y);
         ViewRays {
             origin: o.as_vec3(),
             base: base.as_vec3(),
@@ -114,7 +118,11 @@ impl LightFieldCamera {
     pub fn blender_rotation(&self) -> [f64; 3] {
         // Blender world = (x, -z, y) of ours; a Blender camera looks down its local -Z, up +Y.
         let to_blender = |v: DVec3| DVec3::new(v.x, -v.z, v.y);
-        let cols = [to_blender(self.right()), to_blender(self.up), to_blender(-self.forward)];
+        let cols = [
+            to_blender(self.right()),
+            to_blender(self.up),
+            to_blender(-self.forward),
+        ];
         let r = |row: usize, col: usize| cols[col][row];
         let x = r(2, 1).atan2(r(2, 2));
         let y = (-r(2, 0)).clamp(-1.0, 1.0).asin();
@@ -142,7 +150,10 @@ impl ViewRays {
     /// Ray through image position `(x, y)` (pixel `(i, j)` covers `[i, i+1) × [j, j+1)`).
     #[inline]
     pub fn ray(&self, x: f32, y: f32) -> CameraRay {
-        CameraRay { origin: self.origin, dir: self.base + self.dx * x + self.dy * y }
+        CameraRay {
+            origin: self.origin,
+            dir: self.base + self.dx * x + self.dy * y,
+        }
     }
 }
 
@@ -210,7 +221,11 @@ mod tests {
         c.fit_disparity_range(1.5, 9.0, [-3.5, 3.5]);
         assert!((c.disparity(1.5) - 3.5).abs() < 1e-9);
         assert!((c.disparity(9.0) + 3.5).abs() < 1e-9);
-        assert!((c.depth(1.25) - 1.0 / (1.25 / (c.f_px() * c.baseline_m) + 1.0 / c.focus_distance_m)).abs() < 1e-12);
+        assert!(
+            (c.depth(1.25) - 1.0 / (1.25 / (c.f_px() * c.baseline_m) + 1.0 / c.focus_distance_m))
+                .abs()
+                < 1e-12
+        );
         assert!((c.depth(c.disparity(4.2)) - 4.2).abs() < 1e-9);
     }
 
@@ -222,7 +237,11 @@ mod tests {
         assert_eq!(c.view_offset(80), (4, 4));
         // Looking horizontally along -Z (ours) is Blender's +Y: Euler (90°, 0, 0).
         let r = c.blender_rotation();
-        assert!((r[0] - std::f64::consts::FRAC_PI_2).abs() < 1e-12 && r[1].abs() < 1e-12 && r[2].abs() < 1e-12);
+        assert!(
+            (r[0] - std::f64::consts::FRAC_PI_2).abs() < 1e-12
+                && r[1].abs() < 1e-12
+                && r[2].abs() < 1e-12
+        );
         assert_eq!(c.blender_position(), [0.3, -0.5, 1.2]);
         // Row 0 is the top row: its cameras are above the centre.
         assert!(c.view_origin(0).y > c.position.y && c.view_origin(0).x < c.position.x);

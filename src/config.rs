@@ -39,7 +39,13 @@ pub struct DatasetConfig {
 
 impl Default for DatasetConfig {
     fn default() -> Self {
-        Self { scenes: 110, seed: 0, val_every: 11, out: "datasets/lfgen".into(), date: String::new() }
+        Self {
+            scenes: 110,
+            seed: 0,
+            val_every: 11,
+            out: "datasets/lfgen".into(),
+            date: String::new(),
+        }
     }
 }
 
@@ -106,6 +112,17 @@ pub enum SliceSpacing {
     Disparity,
 }
 
+/// Which depth decides a hit's slice.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SliceAssignment {
+    /// The depth of the hit's surface (its triangle's plane) at the pixel centre: a continuous
+    /// surface is never cut by a slice boundary inside a pixel.
+    Surface,
+    /// The sample's own hit depth: literal camera-side clipping, as in the thesis.
+    Sample,
+}
+
 /// Path tracer and ground-truth settings.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -120,6 +137,7 @@ pub struct RenderConfig {
     /// Number of depth slices S.
     pub slices: u32,
     pub slice_spacing: SliceSpacing,
+    pub slice_assignment: SliceAssignment,
     /// A slice is a mode when its η (or η_exact) exceeds this.
     pub mode_epsilon: f64,
     /// Shade every slice and write `slices.exr` (centre view); costs a shading per hit.
@@ -141,6 +159,7 @@ impl Default for RenderConfig {
             gt_views: GtViews::Center,
             slices: 128,
             slice_spacing: SliceSpacing::Depth,
+            slice_assignment: SliceAssignment::Surface,
             mode_epsilon: 1e-4,
             write_slices: false,
             write_exr: false,
@@ -224,8 +243,11 @@ impl Config {
             apply_set(&mut table, s)?;
         }
         let origin = path.map_or("built-in defaults".into(), |p| p.display().to_string());
-        let cfg: Config = table.try_into().with_context(|| format!("{origin}: invalid config"))?;
-        cfg.validate().with_context(|| format!("{origin}: invalid config"))?;
+        let cfg: Config = table
+            .try_into()
+            .with_context(|| format!("{origin}: invalid config"))?;
+        cfg.validate()
+            .with_context(|| format!("{origin}: invalid config"))?;
         Ok(cfg)
     }
 
@@ -238,10 +260,20 @@ impl Config {
         if c.resolution.iter().any(|&n| n == 0 || n > 16384) {
             bail!("camera.resolution out of range: {:?}", c.resolution);
         }
-        if !(c.disparity_range[0] < c.disparity_range[1]) {
-            bail!("camera.disparity_range must be increasing, got {:?}", c.disparity_range);
+        if c.disparity_range[0] >= c.disparity_range[1]
+            || c.disparity_range.iter().any(|d| !d.is_finite())
+        {
+            bail!(
+                "camera.disparity_range must be increasing, got {:?}",
+                c.disparity_range
+            );
         }
-        let positive = [c.focal_length_mm, c.sensor_size_mm, c.baseline_mm, c.focus_distance_m];
+        let positive = [
+            c.focal_length_mm,
+            c.sensor_size_mm,
+            c.baseline_mm,
+            c.focus_distance_m,
+        ];
         if positive.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
             bail!("camera focal length, sensor size, baseline and focus must be positive");
         }
@@ -249,7 +281,7 @@ impl Config {
         if r.spp == 0 || r.slices == 0 || r.max_depth == 0 {
             bail!("render.spp, render.slices and render.max_depth must be at least 1");
         }
-        if !(0.0..1.0).contains(&r.mode_epsilon) || !(r.exposure > 0.0) {
+        if !(0.0..1.0).contains(&r.mode_epsilon) || !r.exposure.is_finite() || r.exposure <= 0.0 {
             bail!("render.mode_epsilon must be in [0, 1) and render.exposure positive");
         }
         self.scene.validate()
@@ -264,8 +296,16 @@ impl Config {
 
 impl SceneConfig {
     fn validate(&self) -> Result<()> {
-        let ranges = [self.room_width, self.room_depth, self.room_height, self.opacity_range];
-        if ranges.iter().any(|[a, b]| !(a.is_finite() && *a > 0.0 && a <= b)) {
+        let ranges = [
+            self.room_width,
+            self.room_depth,
+            self.room_height,
+            self.opacity_range,
+        ];
+        if ranges
+            .iter()
+            .any(|[a, b]| !(a.is_finite() && *a > 0.0 && a <= b))
+        {
             bail!("scene ranges must be positive [min, max] pairs");
         }
         let probs = [self.semi_transparent, self.glass, self.cutout];
@@ -313,7 +353,10 @@ fn check_known_key(path: &[&str]) -> Result<()> {
             Some(_) if i + 1 == path.len() => bail!("{:?} is a section, not a key", path.join(".")),
             _ => {
                 let known: Vec<&String> = node.keys().collect();
-                bail!("unknown config key {:?} (known here: {known:?})", path.join("."));
+                bail!(
+                    "unknown config key {:?} (known here: {known:?})",
+                    path.join(".")
+                );
             }
         }
     }
@@ -334,14 +377,20 @@ mod tests {
         let defaults = toml::Table::try_from(Config::default()).unwrap();
         for (section, keys) in &defaults {
             for key in keys.as_table().unwrap().keys() {
-                assert!(file[section].as_table().unwrap().contains_key(key), "{section}.{key} undocumented");
+                assert!(
+                    file[section].as_table().unwrap().contains_key(key),
+                    "{section}.{key} undocumented"
+                );
             }
         }
     }
 
     #[test]
     fn sets_override_and_unknown_keys_are_named() {
-        let sets = ["camera.resolution=[64,48]".to_string(), "render.gt_views=all".to_string()];
+        let sets = [
+            "camera.resolution=[64,48]".to_string(),
+            "render.gt_views=all".to_string(),
+        ];
         let cfg = Config::load(None, &["quick".into()], &sets).unwrap();
         assert_eq!(cfg.camera.resolution, [64, 48]);
         assert_eq!(cfg.render.gt_views, GtViews::All);

@@ -30,7 +30,11 @@ pub struct GenerateOptions {
 /// Split of scene `index` (see `dataset.val_every`).
 pub fn split_of(cfg: &Config, index: u64) -> &'static str {
     let every = cfg.dataset.val_every;
-    if every > 0 && index % every == every - 1 { "val" } else { "train" }
+    if every > 0 && index % every == every - 1 {
+        "val"
+    } else {
+        "train"
+    }
 }
 
 /// Folder of scene `index`, relative to the dataset root.
@@ -39,7 +43,11 @@ pub fn scene_dir(cfg: &Config, index: u64) -> String {
 }
 
 fn manifest_name((i, n): (u64, u64)) -> String {
-    if n > 1 { format!("manifest.shard-{i}-of-{n}.json") } else { "manifest.json".into() }
+    if n > 1 {
+        format!("manifest.shard-{i}-of-{n}.json")
+    } else {
+        "manifest.json".into()
+    }
 }
 
 /// Generates the dataset (or this shard of it).
@@ -47,34 +55,61 @@ pub fn generate(cfg: &Config, opts: &GenerateOptions) -> Result<()> {
     check_writable(&opts.out)?;
     let manifest_path = opts.out.join(manifest_name(opts.shard));
     let mut manifest = open_manifest(cfg, opts, &manifest_path)?;
-    let todo: Vec<u64> = (0..opts.scenes).filter(|i| i % opts.shard.1 == opts.shard.0).collect();
-    let date = if cfg.dataset.date.is_empty() { today() } else { cfg.dataset.date.clone() };
+    let todo: Vec<u64> = (0..opts.scenes)
+        .filter(|i| i % opts.shard.1 == opts.shard.0)
+        .collect();
+    let date = if cfg.dataset.date.is_empty() {
+        today()
+    } else {
+        cfg.dataset.date.clone()
+    };
     let job = RenderJob::from_config(cfg, &date);
     let [w, h] = cfg.camera.resolution;
-    let per_scene = w as u64 * h as u64 * cfg.render.spp as u64 * (cfg.camera.grid[0] * cfg.camera.grid[1]) as u64;
+    let per_scene = w as u64
+        * h as u64
+        * cfg.render.spp as u64
+        * (cfg.camera.grid[0] * cfg.camera.grid[1]) as u64;
     let bar = progress_bar(todo.len() as u64 * per_scene, opts.quiet);
     let samples = AtomicU64::new(0);
     let (mut done, mut skipped) = (0, 0);
     for index in todo {
         let dir = scene_dir(cfg, index);
-        if opts.resume && manifest.scenes.iter().any(|e| e.index == index && scene_entry_verifies(&opts.out, e)) {
+        if opts.resume
+            && manifest
+                .scenes
+                .iter()
+                .any(|e| e.index == index && scene_entry_verifies(&opts.out, e))
+        {
             skipped += 1;
             samples.fetch_add(per_scene, Ordering::Relaxed);
             continue;
         }
         let started = Instant::now();
-        let (mut desc, scene) = generate_scene(cfg, index).with_context(|| format!("scene {index}"))?;
+        let (mut desc, scene) =
+            generate_scene(cfg, index).with_context(|| format!("scene {index}"))?;
         let before = samples.load(Ordering::Relaxed);
         let files = std::thread::scope(|s| {
             let ticker = s.spawn(|| tick(&bar, &samples, before + per_scene));
-            let r = render_scene(&mut desc, &scene, &job, &opts.out.join(&dir), &opts.out, &samples);
+            let r = render_scene(
+                &mut desc,
+                &scene,
+                &job,
+                &opts.out.join(&dir),
+                &opts.out,
+                &samples,
+            );
             samples.store(before + per_scene, Ordering::Relaxed);
             ticker.join().expect("progress thread");
             r
         })
         .with_context(|| format!("scene {index} ({dir})"))?;
         manifest.scenes.retain(|e| e.index != index);
-        manifest.scenes.push(SceneEntry { index, split: split_of(cfg, index).into(), dir: dir.clone(), files });
+        manifest.scenes.push(SceneEntry {
+            index,
+            split: split_of(cfg, index).into(),
+            dir: dir.clone(),
+            files,
+        });
         manifest.scenes.sort_by_key(|e| e.index);
         manifest.splits = count_splits(&manifest.scenes);
         manifest.write(&manifest_path)?;
@@ -82,7 +117,9 @@ pub fn generate(cfg: &Config, opts: &GenerateOptions) -> Result<()> {
         done += 1;
         bar.set_message(format!("{done} scenes rendered, {skipped} verified"));
     }
-    bar.finish_with_message(format!("{done} scenes rendered, {skipped} verified and kept"));
+    bar.finish_with_message(format!(
+        "{done} scenes rendered, {skipped} verified and kept"
+    ));
     if opts.shard.1 == 1 {
         write_readme(&opts.out, &manifest)?;
     }
@@ -107,7 +144,11 @@ fn progress_bar(total: u64, quiet: bool) -> ProgressBar {
     }
     let bar = ProgressBar::new(total);
     let style = "{elapsed_precise} [{bar:30}] {percent}% {human_pos}/{human_len} camera rays, {per_sec}, ETA {eta} — {msg}";
-    bar.set_style(ProgressStyle::with_template(style).expect("valid template").progress_chars("=> "));
+    bar.set_style(
+        ProgressStyle::with_template(style)
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
     bar
 }
 
@@ -134,9 +175,15 @@ fn open_manifest(cfg: &Config, opts: &GenerateOptions, path: &Path) -> Result<Ma
         );
     }
     if old.config_hash != fresh.config_hash {
-        bail!("{}: the dataset was generated with a different config; resume needs the same config", path.display());
+        bail!(
+            "{}: the dataset was generated with a different config; resume needs the same config",
+            path.display()
+        );
     }
-    Ok(Manifest { scenes: old.scenes, ..fresh })
+    Ok(Manifest {
+        scenes: old.scenes,
+        ..fresh
+    })
 }
 
 fn count_splits(scenes: &[SceneEntry]) -> BTreeMap<String, u64> {
@@ -149,17 +196,24 @@ fn count_splits(scenes: &[SceneEntry]) -> BTreeMap<String, u64> {
 
 /// Fails early, naming the folder, when the output cannot be written.
 fn check_writable(out: &Path) -> Result<()> {
-    fs::create_dir_all(out).with_context(|| format!("cannot create output folder {}", out.display()))?;
+    fs::create_dir_all(out)
+        .with_context(|| format!("cannot create output folder {}", out.display()))?;
     let probe = out.join(".lfgen-write-test");
-    fs::write(&probe, b"ok").with_context(|| format!("output folder {} is not writable", out.display()))?;
-    fs::remove_file(&probe).with_context(|| format!("output folder {} is not writable", out.display()))
+    fs::write(&probe, b"ok")
+        .with_context(|| format!("output folder {} is not writable", out.display()))?;
+    fs::remove_file(&probe)
+        .with_context(|| format!("output folder {} is not writable", out.display()))
 }
 
 /// Render timings live outside the scene folders so those stay byte-reproducible.
 fn log_timing(out: &Path, index: u64, seconds: f64, samples: u64) -> Result<()> {
     let path = out.join("timings.jsonl");
     let line = serde_json::json!({ "scene": index, "seconds": seconds, "camera_rays_per_second": samples as f64 / seconds });
-    let mut f = fs::OpenOptions::new().create(true).append(true).open(&path).with_context(|| format!("cannot write {}", path.display()))?;
+    let mut f = fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(&path)
+        .with_context(|| format!("cannot write {}", path.display()))?;
     writeln!(f, "{line}").with_context(|| format!("cannot write {}", path.display()))
 }
 
@@ -169,15 +223,23 @@ pub fn merge(out: &Path) -> Result<Manifest> {
     let mut parts = Vec::new();
     for entry in fs::read_dir(out).with_context(|| format!("cannot list {}", out.display()))? {
         let name = entry?.file_name().to_string_lossy().into_owned();
-        if name == "manifest.json" || (name.starts_with("manifest.shard-") && name.ends_with(".json")) {
+        if name == "manifest.json"
+            || (name.starts_with("manifest.shard-") && name.ends_with(".json"))
+        {
             parts.push(Manifest::read(&out.join(&name))?);
         }
     }
-    let mut merged = parts.first().cloned().with_context(|| format!("{}: no manifest to merge", out.display()))?;
+    let mut merged = parts
+        .first()
+        .cloned()
+        .with_context(|| format!("{}: no manifest to merge", out.display()))?;
     let mut scenes = BTreeMap::new();
     for p in &parts {
         if p.config_hash != merged.config_hash {
-            bail!("{}: shards were generated with different configs", out.display());
+            bail!(
+                "{}: shards were generated with different configs",
+                out.display()
+            );
         }
         for e in &p.scenes {
             if scene_entry_verifies(out, e) {

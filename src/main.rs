@@ -103,7 +103,11 @@ fn run(cli: Cli) -> Result<()> {
         }
         Some(Command::Merge { dataset }) => {
             let m = dataset::merge(&dataset)?;
-            println!("{}: manifest.json with {} verified scenes", dataset.display(), m.scenes.len());
+            println!(
+                "{}: manifest.json with {} verified scenes",
+                dataset.display(),
+                m.scenes.len()
+            );
             Ok(())
         }
         Some(Command::Bench(a)) => {
@@ -117,10 +121,16 @@ fn run(cli: Cli) -> Result<()> {
 /// Loads the config and sets up the thread pool.
 fn load(a: &ConfigArgs) -> Result<Config> {
     if let Some(n) = a.threads {
-        rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("cannot set --threads")?;
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .context("cannot set --threads")?;
     }
     let default = PathBuf::from("generator.toml");
-    let path = a.config.clone().or_else(|| default.exists().then_some(default));
+    let path = a
+        .config
+        .clone()
+        .or_else(|| default.exists().then_some(default));
     Config::load(path.as_deref(), &a.preset, &a.sets)
 }
 
@@ -146,7 +156,9 @@ fn generate(a: GenerateArgs) -> Result<()> {
 }
 
 fn parse_shard(s: &str) -> Result<(u64, u64)> {
-    let parsed = s.split_once('/').and_then(|(i, n)| Some((i.trim().parse().ok()?, n.trim().parse().ok()?)));
+    let parsed = s
+        .split_once('/')
+        .and_then(|(i, n)| Some((i.trim().parse().ok()?, n.trim().parse().ok()?)));
     match parsed {
         Some((i, n)) if n > 0 && i < n => Ok((i, n)),
         _ => bail!("--shard {s:?}: expected I/N with 0 <= I < N"),

@@ -1,11 +1,11 @@
 //! One scene from description to published folder: build, frame, render every view, write.
 
-use crate::config::{Config, GtViews};
+use crate::config::{Config, GtViews, SliceAssignment};
 use crate::output::scene_dir::{GtImages, SceneWriter};
+use crate::render::RenderScene;
 use crate::render::framing::auto_exposure;
 use crate::render::integrator::PathSettings;
 use crate::render::view::{RenderSettings, ViewOutput};
-use crate::render::RenderScene;
 use crate::scene::{SceneDesc, builtin};
 use crate::stats::SceneStats;
 use anyhow::Result;
@@ -23,6 +23,8 @@ pub struct RenderJob {
     pub write_exr: bool,
     /// Shade every hit of GT rays (true slice colours).
     pub shade_all_hits: bool,
+    /// Slice hits by their surface's depth at the pixel centre.
+    pub slice_by_surface: bool,
     /// Choose the exposure from the centre view (else keep the scene's).
     pub auto_exposure: bool,
     /// Date written into parameters.cfg.
@@ -34,11 +36,15 @@ impl RenderJob {
         let r = &cfg.render;
         Self {
             spp: r.spp,
-            path: PathSettings { max_depth: r.max_depth, rr_depth: r.rr_depth },
+            path: PathSettings {
+                max_depth: r.max_depth,
+                rr_depth: r.rr_depth,
+            },
             gt_views: r.gt_views,
             mode_epsilon: r.mode_epsilon as f32,
             write_exr: r.write_exr,
             shade_all_hits: r.write_slices,
+            slice_by_surface: r.slice_assignment == SliceAssignment::Surface,
             auto_exposure: r.auto_exposure,
             date: date.to_string(),
         }
@@ -53,6 +59,7 @@ impl RenderJob {
             scene_index: desc.index,
             mode_epsilon: self.mode_epsilon,
             shade_all_hits: self.shade_all_hits,
+            slice_by_surface: self.slice_by_surface,
         }
     }
 }
@@ -61,7 +68,12 @@ impl RenderJob {
 pub fn generate_scene(cfg: &Config, index: u64) -> Result<(SceneDesc, RenderScene)> {
     let mut desc = builtin::generate(cfg, index);
     let scene = RenderScene::build(&desc)?;
-    desc.slices = scene.frame(&mut desc.camera, &cfg.camera, cfg.render.slices, cfg.render.slice_spacing)?;
+    desc.slices = scene.frame(
+        &mut desc.camera,
+        &cfg.camera,
+        cfg.render.slices,
+        cfg.render.slice_spacing,
+    )?;
     Ok((desc, scene))
 }
 
@@ -85,13 +97,30 @@ pub fn render_scene(
     let mut stats = None;
     for view in order {
         let with_gt = view == center || per_view;
-        let out = scene.render_view(&desc.camera, &desc.slices, &settings, view, with_gt, samples_done);
+        let out = scene.render_view(
+            &desc.camera,
+            &desc.slices,
+            &settings,
+            view,
+            with_gt,
+            samples_done,
+        );
         if view == center && job.auto_exposure {
             desc.exposure *= auto_exposure(&out.image.pixels);
         }
-        writer.write_view(view, out.image.width, out.image.height, &out.image.pixels, desc.exposure)?;
+        writer.write_view(
+            view,
+            out.image.width,
+            out.image.height,
+            &out.image.pixels,
+            desc.exposure,
+        )?;
         if let Some(gt) = &out.gt {
-            let images = GtImages { modes: &gt.modes, colors: &gt.colors, hci_depth: &gt.hci_depth };
+            let images = GtImages {
+                modes: &gt.modes,
+                colors: &gt.colors,
+                hci_depth: &gt.hci_depth,
+            };
             writer.write_gt(view, view == center, per_view, &desc.camera, &images)?;
         }
         if view == center {
@@ -101,9 +130,18 @@ pub fn render_scene(
     writer.finish(desc, &stats.expect("centre view rendered"), root)
 }
 
-fn scene_stats(desc: &SceneDesc, scene: &RenderScene, out: &ViewOutput, job: &RenderJob) -> SceneStats {
+fn scene_stats(
+    desc: &SceneDesc,
+    scene: &RenderScene,
+    out: &ViewOutput,
+    job: &RenderJob,
+) -> SceneStats {
     let gt = out.gt.as_ref().expect("centre view has GT");
-    let hci_disp: Vec<f32> = gt.hci_depth.iter().map(|&z| desc.camera.disparity(z as f64) as f32).collect();
+    let hci_disp: Vec<f32> = gt
+        .hci_depth
+        .iter()
+        .map(|&z| desc.camera.disparity(z as f64) as f32)
+        .collect();
     let mut s = SceneStats::from_gt(&gt.modes, &hci_disp);
     s.baseline_mm = desc.camera.baseline_m * 1000.0;
     s.focus_distance_m = desc.camera.focus_distance_m;
@@ -118,18 +156,30 @@ fn scene_stats(desc: &SceneDesc, scene: &RenderScene, out: &ViewOutput, job: &Re
 /// slices and exposure, and the render settings of `cfg`.
 pub fn rerender(cfg: &Config, scene_json: &Path, out: &Path, quiet: bool) -> Result<()> {
     use anyhow::Context;
-    let text = std::fs::read_to_string(scene_json).with_context(|| format!("cannot read {}", scene_json.display()))?;
-    let mut desc: SceneDesc =
-        serde_json::from_str(&text).with_context(|| format!("{}: not a valid lfgen scene", scene_json.display()))?;
+    let text = std::fs::read_to_string(scene_json)
+        .with_context(|| format!("cannot read {}", scene_json.display()))?;
+    let mut desc: SceneDesc = serde_json::from_str(&text)
+        .with_context(|| format!("{}: not a valid lfgen scene", scene_json.display()))?;
     let scene = RenderScene::build(&desc).with_context(|| format!("{}", scene_json.display()))?;
     let date = cfg.dataset.date.clone();
-    let job = RenderJob { auto_exposure: false, ..RenderJob::from_config(cfg, &date) };
-    let root = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let job = RenderJob {
+        auto_exposure: false,
+        ..RenderJob::from_config(cfg, &date)
+    };
+    let root = out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     std::fs::create_dir_all(root).with_context(|| format!("cannot create {}", root.display()))?;
     let samples = AtomicU64::new(0);
     render_scene(&mut desc, &scene, &job, out, root, &samples)?;
     if !quiet {
-        eprintln!("{}: {} camera rays, written to {}", desc.name, samples.into_inner(), out.display());
+        eprintln!(
+            "{}: {} camera rays, written to {}",
+            desc.name,
+            samples.into_inner(),
+            out.display()
+        );
     }
     Ok(())
 }

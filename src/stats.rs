@@ -54,11 +54,17 @@ impl SceneStats {
         let mut hist = vec![0.0f64; HIST_BINS];
         let width = (hi - lo).max(1e-9);
         for m in modes.pixels().flatten() {
-            let k = (((m.disparity as f64 - lo) / width * HIST_BINS as f64) as usize).min(HIST_BINS - 1);
+            let k = (((m.disparity as f64 - lo) / width * HIST_BINS as f64) as usize)
+                .min(HIST_BINS - 1);
             hist[k] += m.eta as f64 / pixels;
         }
-        let finite = hci_disparity.iter().filter(|d| d.is_finite()).map(|&d| d as f64);
-        let hci = finite.fold([f64::INFINITY, f64::NEG_INFINITY], |[a, b], d| [a.min(d), b.max(d)]);
+        let finite = hci_disparity
+            .iter()
+            .filter(|d| d.is_finite())
+            .map(|&d| d as f64);
+        let hci = finite.fold([f64::INFINITY, f64::NEG_INFINITY], |[a, b], d| {
+            [a.min(d), b.max(d)]
+        });
         Self {
             multimodal_fraction: multimodal as f64 / pixels,
             mode_count_histogram: counts,
@@ -84,7 +90,12 @@ mod tests {
     #[test]
     fn counts_multimodal_pixels_and_histogram_mass() {
         let mut map = ModeMap::new(2, 1);
-        let m = |d: f32, eta: f32| Mode { disparity: d, depth: 1.0, eta, eta_exact: eta };
+        let m = |d: f32, eta: f32| Mode {
+            disparity: d,
+            depth: 1.0,
+            eta,
+            eta_exact: eta,
+        };
         map.push_pixel(&[m(1.0, 0.4), m(-1.0, 0.6)]);
         map.push_pixel(&[m(0.0, 1.0)]);
         let s = SceneStats::from_gt(&map, &[0.5, f32::NAN]);

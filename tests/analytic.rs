@@ -487,6 +487,68 @@ fn closed_room_eta_sums_to_one_and_modes_sorted() {
         }
     }
     assert!(back_wall_pixels > 300, "{back_wall_pixels}");
+    // With surface slicing a continuous surface is one layer per pixel, so Σ η falls short
+    // only where two different surfaces with disjoint coverage meet (the room's creases);
+    // literal per-sample clipping also cuts every slanted surface at every slice boundary.
+    let short = |g: &ViewGt| {
+        pixels(&g.modes)
+            .filter(|&(x, y)| eta_sum(g.modes.pixel(x, y)) < 1.0 - 1e-3)
+            .count()
+    };
+    let by_surface = short(&g);
+    let mut literal = settings(16, 2);
+    literal.slice_by_surface = false;
+    let by_sample = short(&gt(h.render(cam.center_view(), &literal, true)));
+    let total = g.modes.width * g.modes.height;
+    assert!(
+        by_surface * 10 < total,
+        "Σ η < 1 at {by_surface} of {total} pixels"
+    );
+    assert!(
+        by_sample > 10 * by_surface,
+        "sample slicing {by_sample} vs surface {by_surface}"
+    );
+}
+
+fn eta_sum(modes: &[Mode]) -> f32 {
+    modes.iter().map(|m| m.eta).sum()
+}
+
+/// A floor-like plane receding from the camera crosses many slice boundaries inside pixels.
+/// Surface slicing keeps it one mode with η = 1 everywhere; per-sample clipping splits the
+/// boundary pixels into several modes whose over-composited η sum to less than 1.
+#[test]
+fn slanted_plane_is_one_mode_with_surface_slicing() {
+    let cam = camera([32, 32], [5, 5], 100.0, EYE);
+    let tilt = Transform {
+        rotation: Quat::from_rotation_x(-1.2),
+        ..Transform::at(ahead(3.0, 0.0, 0.0))
+    };
+    let plane = Part {
+        shape: Shape::Quad { size: [8.0, 8.0] },
+        transform: tilt,
+        material: matte([0.5; 3], 1.0),
+    };
+    let h = Harness::new(scene(cam.clone(), [2.0, 4.0], [1.0; 3], vec![plane]));
+    let g = gt(h.render(cam.center_view(), &settings(16, 1), true));
+    for (x, y) in pixels(&g.modes) {
+        let modes = g.modes.pixel(x, y);
+        assert_eq!(modes.len(), 1, "pixel ({x}, {y}): {modes:?}");
+        assert!(
+            (modes[0].eta - 1.0).abs() < 1e-6,
+            "pixel ({x}, {y}): {modes:?}"
+        );
+    }
+    let mut literal = settings(16, 1);
+    literal.slice_by_surface = false;
+    let g = gt(h.render(cam.center_view(), &literal, true));
+    let split = pixels(&g.modes)
+        .filter(|&(x, y)| g.modes.pixel(x, y).len() >= 2)
+        .count();
+    assert!(
+        split > 32,
+        "per-sample clipping should split boundary pixels, got {split}"
+    );
 }
 
 // ---------------------------------------------------------------------------------------

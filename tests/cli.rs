@@ -24,11 +24,19 @@ const TINY: &[&str] = &[
 ];
 
 fn lfgen(args: &[&str], extra: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_lfgen")).args(args).args(extra).output().expect("lfgen runs")
+    Command::new(env!("CARGO_BIN_EXE_lfgen"))
+        .args(args)
+        .args(extra)
+        .output()
+        .expect("lfgen runs")
 }
 
 fn ok(out: Output) -> Output {
-    assert!(out.status.success(), "lfgen failed: {}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "lfgen failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     out
 }
 
@@ -50,7 +58,10 @@ fn files(root: &Path) -> BTreeMap<String, Vec<u8>> {
             if p.is_dir() {
                 stack.push(p);
             } else if p.file_name().unwrap() != "timings.jsonl" {
-                out.insert(p.strip_prefix(root).unwrap().display().to_string(), fs::read(&p).unwrap());
+                out.insert(
+                    p.strip_prefix(root).unwrap().display().to_string(),
+                    fs::read(&p).unwrap(),
+                );
             }
         }
     }
@@ -70,7 +81,11 @@ fn same_seed_is_byte_identical_across_thread_counts_and_seeds_differ() {
     ok(generate(b.path(), "2", &["--threads", "2"]));
     ok(generate(c.path(), "2", &["--threads", "2", "--seed", "7"]));
     let (fa, fb, fc) = (files(a.path()), files(b.path()), files(c.path()));
-    assert!(fa.contains_key("train/scene_0000/input_Cam004.png"), "{:?}", fa.keys());
+    assert!(
+        fa.contains_key("train/scene_0000/input_Cam004.png"),
+        "{:?}",
+        fa.keys()
+    );
     assert_eq!(fa.keys().collect::<Vec<_>>(), fb.keys().collect::<Vec<_>>());
     for (name, bytes) in &fa {
         assert!(bytes == &fb[name], "{name} differs between 1 and 2 threads");
@@ -84,12 +99,23 @@ fn scene_folder_has_every_hci_and_multimodal_file() {
     let d = tmp();
     ok(generate(d.path(), "1", &[]));
     let scene = d.path().join("train/scene_0000");
-    let mut names: Vec<String> = fs::read_dir(&scene).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
+    let mut names: Vec<String> = fs::read_dir(&scene)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
     names.sort();
     let mut expected: Vec<String> = (0..9).map(|i| format!("input_Cam{i:03}.png")).collect();
     expected.extend(
-        ["gt_depth_lowres.pfm", "gt_disp_lowres.pfm", "gt_mpi_lowres.npz", "modes.exr", "parameters.cfg", "scene.json", "stats.json"]
-            .map(String::from),
+        [
+            "gt_depth_lowres.pfm",
+            "gt_disp_lowres.pfm",
+            "gt_mpi_lowres.npz",
+            "modes.exr",
+            "parameters.cfg",
+            "scene.json",
+            "stats.json",
+        ]
+        .map(String::from),
     );
     expected.sort();
     assert_eq!(names, expected);
@@ -118,8 +144,15 @@ fn parameters_cfg_formula_reproduces_gt_disp_from_gt_depth() {
     ok(generate(d.path(), "1", &[]));
     let scene = d.path().join("train/scene_0000");
     let cfg = ini(&scene.join("parameters.cfg"));
-    let f = |k: &str| cfg[k].parse::<f64>().unwrap_or_else(|_| panic!("{k} = {}", cfg[k]));
-    let (w, h) = (f("intrinsics.image_resolution_x_px"), f("intrinsics.image_resolution_y_px"));
+    let f = |k: &str| {
+        cfg[k]
+            .parse::<f64>()
+            .unwrap_or_else(|_| panic!("{k} = {}", cfg[k]))
+    };
+    let (w, h) = (
+        f("intrinsics.image_resolution_x_px"),
+        f("intrinsics.image_resolution_y_px"),
+    );
     assert_eq!((w, h), (40.0, 32.0));
     assert_eq!(f("extrinsics.num_cams_x"), 3.0);
     let f_px = f("intrinsics.focal_length_mm") * w.max(h) / f("intrinsics.sensor_size_mm");
@@ -130,11 +163,17 @@ fn parameters_cfg_formula_reproduces_gt_disp_from_gt_depth() {
     assert_eq!((depth.width, depth.height), (40, 32));
     for (z, d) in depth.data.iter().zip(&disp.data) {
         let expected = f_px * b * (1.0 / *z as f64 - 1.0 / zf);
-        assert!((expected - *d as f64).abs() < 1e-4 * expected.abs().max(1.0), "{d} vs {expected}");
+        assert!(
+            (expected - *d as f64).abs() < 1e-4 * expected.abs().max(1.0),
+            "{d} vs {expected}"
+        );
     }
     // The configured disparity range is met and written with HCI's rounding.
     let (lo, hi) = (f("meta.disp_min"), f("meta.disp_max"));
-    assert!(lo >= -3.7 && hi <= 3.7 && lo < -1.0 && hi > 1.0, "{lo} {hi}");
+    assert!(
+        lo >= -3.7 && hi <= 3.7 && lo < -1.0 && hi > 1.0,
+        "{lo} {hi}"
+    );
 }
 
 #[test]
@@ -144,7 +183,10 @@ fn killed_run_resumes_to_the_same_bytes_and_never_leaves_half_scenes() {
     let out = killed.path().to_str().unwrap();
     let mut args = vec!["--scenes", "3", "--out", out];
     args.extend_from_slice(TINY);
-    let mut child = Command::new(env!("CARGO_BIN_EXE_lfgen")).args(&args).spawn().unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lfgen"))
+        .args(&args)
+        .spawn()
+        .unwrap();
     // Kill it as soon as the first scene is published: later scenes are then in flight.
     let manifest = killed.path().join("manifest.json");
     while !manifest.exists() && child.try_wait().unwrap().is_none() {
@@ -154,11 +196,19 @@ fn killed_run_resumes_to_the_same_bytes_and_never_leaves_half_scenes() {
     child.wait().unwrap();
     // Whatever was published is complete; partial work only ever sits in hidden folders.
     if let Ok(m) = Manifest::read(&killed.path().join("manifest.json")) {
-        assert!(m.scenes.iter().all(|e| lfformat::manifest::scene_entry_verifies(killed.path(), e)));
+        assert!(
+            m.scenes
+                .iter()
+                .all(|e| lfformat::manifest::scene_entry_verifies(killed.path(), e))
+        );
     }
     // Damage one published scene by hand as well: resume must redo it.
     let rerun = generate(killed.path(), "3", &[]);
-    assert!(!rerun.status.success() && stderr(&rerun).contains("--resume"), "{}", stderr(&rerun));
+    assert!(
+        !rerun.status.success() && stderr(&rerun).contains("--resume"),
+        "{}",
+        stderr(&rerun)
+    );
     ok(generate(killed.path(), "3", &["--resume"]));
     fs::remove_file(killed.path().join("train/scene_0001/modes.exr")).unwrap();
     ok(generate(killed.path(), "3", &["--resume"]));
@@ -187,7 +237,15 @@ fn rerendering_scene_json_reproduces_the_scene() {
     let scene = d.path().join("train/scene_0000");
     let again = d.path().join("again");
     let json = scene.join("scene.json");
-    ok(lfgen(&["render", json.to_str().unwrap(), "--out", again.to_str().unwrap()], TINY));
+    ok(lfgen(
+        &[
+            "render",
+            json.to_str().unwrap(),
+            "--out",
+            again.to_str().unwrap(),
+        ],
+        TINY,
+    ));
     assert!(files(&scene) == files(&again), "re-render differs");
 }
 
@@ -204,23 +262,63 @@ fn bad_input_gives_clear_errors_and_no_scene() {
         (&["--shard", "3/2"], "--shard"),
     ];
     for (args, needle) in cases {
-        let r = lfgen(&[&["--scenes", "1", "--out", o][..], args].concat(), &["--quiet"]);
-        assert!(!r.status.success() && stderr(&r).contains(needle), "{args:?}: {}", stderr(&r));
+        let r = lfgen(
+            &[&["--scenes", "1", "--out", o][..], args].concat(),
+            &["--quiet"],
+        );
+        assert!(
+            !r.status.success() && stderr(&r).contains(needle),
+            "{args:?}: {}",
+            stderr(&r)
+        );
     }
     let bad_toml = d.path().join("bad.toml");
     fs::write(&bad_toml, "[render]\nspp = = 3\n").unwrap();
-    let r = lfgen(&["--config", bad_toml.to_str().unwrap(), "--out", o], &["--quiet"]);
-    assert!(!r.status.success() && stderr(&r).contains("bad.toml"), "{}", stderr(&r));
+    let r = lfgen(
+        &["--config", bad_toml.to_str().unwrap(), "--out", o],
+        &["--quiet"],
+    );
+    assert!(
+        !r.status.success() && stderr(&r).contains("bad.toml"),
+        "{}",
+        stderr(&r)
+    );
     let unknown = d.path().join("unknown.toml");
     fs::write(&unknown, "[render]\nspp = 3\ncolour = true\n").unwrap();
-    let r = lfgen(&["--config", unknown.to_str().unwrap(), "--out", o], &["--quiet"]);
-    assert!(!r.status.success() && stderr(&r).contains("colour"), "{}", stderr(&r));
+    let r = lfgen(
+        &["--config", unknown.to_str().unwrap(), "--out", o],
+        &["--quiet"],
+    );
+    assert!(
+        !r.status.success() && stderr(&r).contains("colour"),
+        "{}",
+        stderr(&r)
+    );
     let blocker = d.path().join("file");
     fs::write(&blocker, "not a folder").unwrap();
     let under_file: PathBuf = blocker.join("ds");
     let r = generate(&under_file, "1", &[]);
-    assert!(!r.status.success() && stderr(&r).contains("cannot create output folder"), "{}", stderr(&r));
-    assert!(!out.join("train").exists(), "a failed run must not leave scenes");
-    let r = lfgen(&["render", d.path().join("missing.json").to_str().unwrap(), "--out", o], &[]);
-    assert!(!r.status.success() && stderr(&r).contains("missing.json"), "{}", stderr(&r));
+    assert!(
+        !r.status.success() && stderr(&r).contains("cannot create output folder"),
+        "{}",
+        stderr(&r)
+    );
+    assert!(
+        !out.join("train").exists(),
+        "a failed run must not leave scenes"
+    );
+    let r = lfgen(
+        &[
+            "render",
+            d.path().join("missing.json").to_str().unwrap(),
+            "--out",
+            o,
+        ],
+        &[],
+    );
+    assert!(
+        !r.status.success() && stderr(&r).contains("missing.json"),
+        "{}",
+        stderr(&r)
+    );
 }

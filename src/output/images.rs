@@ -6,7 +6,11 @@ use std::path::Path;
 
 /// The sRGB transfer function of a linear value in [0, 1].
 pub fn linear_to_srgb(v: f32) -> f32 {
-    if v <= 0.003_130_8 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 }
+    if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    }
 }
 
 /// 8-bit sRGB of linear radiance times `exposure`, clamped.
@@ -18,10 +22,17 @@ pub fn to_srgb8(pixels: &[Vec3], exposure: f32) -> Vec<u8> {
         .collect()
 }
 
-pub fn write_png(path: &Path, width: usize, height: usize, pixels: &[Vec3], exposure: f32) -> Result<()> {
+pub fn write_png(
+    path: &Path,
+    width: usize,
+    height: usize,
+    pixels: &[Vec3],
+    exposure: f32,
+) -> Result<()> {
     let buf = image::RgbImage::from_raw(width as u32, height as u32, to_srgb8(pixels, exposure))
         .context("image size mismatch")?;
-    buf.save(path).with_context(|| format!("cannot write {}", path.display()))
+    buf.save(path)
+        .with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// Linear radiance (before exposure) as a float RGB EXR.

@@ -34,13 +34,22 @@ pub struct GtImages<'a> {
 impl SceneWriter {
     /// Starts a scene that will end up at `final_dir` (a stale partial folder is removed).
     pub fn create(final_dir: &Path, write_exr: bool) -> Result<Self> {
-        let name = final_dir.file_name().context("scene folder has no name")?.to_string_lossy();
+        let name = final_dir
+            .file_name()
+            .context("scene folder has no name")?
+            .to_string_lossy();
         let tmp_dir = final_dir.with_file_name(format!(".{name}.partial"));
         if tmp_dir.exists() {
-            fs::remove_dir_all(&tmp_dir).with_context(|| format!("cannot remove stale {}", tmp_dir.display()))?;
+            fs::remove_dir_all(&tmp_dir)
+                .with_context(|| format!("cannot remove stale {}", tmp_dir.display()))?;
         }
-        fs::create_dir_all(&tmp_dir).with_context(|| format!("cannot create {}", tmp_dir.display()))?;
-        Ok(Self { final_dir: final_dir.to_path_buf(), tmp_dir, write_exr })
+        fs::create_dir_all(&tmp_dir)
+            .with_context(|| format!("cannot create {}", tmp_dir.display()))?;
+        Ok(Self {
+            final_dir: final_dir.to_path_buf(),
+            tmp_dir,
+            write_exr,
+        })
     }
 
     fn path(&self, name: &str) -> PathBuf {
@@ -48,24 +57,59 @@ impl SceneWriter {
     }
 
     /// `input_CamNNN.png` (and `.exr` when enabled).
-    pub fn write_view(&self, view: u32, width: usize, height: usize, pixels: &[Vec3], exposure: f32) -> Result<()> {
-        write_png(&self.path(&format!("input_Cam{view:03}.png")), width, height, pixels, exposure)?;
+    pub fn write_view(
+        &self,
+        view: u32,
+        width: usize,
+        height: usize,
+        pixels: &[Vec3],
+        exposure: f32,
+    ) -> Result<()> {
+        write_png(
+            &self.path(&format!("input_Cam{view:03}.png")),
+            width,
+            height,
+            pixels,
+            exposure,
+        )?;
         if self.write_exr {
-            write_linear_exr(&self.path(&format!("input_Cam{view:03}.exr")), width, height, pixels)?;
+            write_linear_exr(
+                &self.path(&format!("input_Cam{view:03}.exr")),
+                width,
+                height,
+                pixels,
+            )?;
         }
         Ok(())
     }
 
     /// Ground-truth files of a view. The centre view gets HCI's unsuffixed names plus the
     /// MPI; with per-view GT (`per_view`) every view also gets `_CamNNN` variants.
-    pub fn write_gt(&self, view: u32, is_center: bool, per_view: bool, cam: &LightFieldCamera, gt: &GtImages) -> Result<()> {
+    pub fn write_gt(
+        &self,
+        view: u32,
+        is_center: bool,
+        per_view: bool,
+        cam: &LightFieldCamera,
+        gt: &GtImages,
+    ) -> Result<()> {
         let (w, h) = (gt.modes.width, gt.modes.height);
         let depth = FloatImage::new(w, h, gt.hci_depth.to_vec());
-        let disp = FloatImage::new(w, h, gt.hci_depth.iter().map(|&z| cam.disparity(z as f64) as f32).collect());
+        let disp = FloatImage::new(
+            w,
+            h,
+            gt.hci_depth
+                .iter()
+                .map(|&z| cam.disparity(z as f64) as f32)
+                .collect(),
+        );
         let mut suffixes = Vec::new();
         if is_center {
             suffixes.push(String::new());
-            write_mpi_npz(&self.path("gt_mpi_lowres.npz"), &Mpi::from_modes(gt.modes, Some(gt.colors)))?;
+            write_mpi_npz(
+                &self.path("gt_mpi_lowres.npz"),
+                &Mpi::from_modes(gt.modes, Some(gt.colors)),
+            )?;
         }
         if per_view {
             suffixes.push(format!("_Cam{view:03}"));
@@ -80,7 +124,12 @@ impl SceneWriter {
 
     /// Writes `parameters.cfg`, `scene.json` and `stats.json`, publishes the folder and returns
     /// its files (paths relative to `root`) with their checksums.
-    pub fn finish(self, desc: &SceneDesc, stats: &SceneStats, root: &Path) -> Result<Vec<FileEntry>> {
+    pub fn finish(
+        self,
+        desc: &SceneDesc,
+        stats: &SceneStats,
+        root: &Path,
+    ) -> Result<Vec<FileEntry>> {
         let params = hci_parameters(desc, stats);
         params.write(&self.path("parameters.cfg"))?;
         write_json(&self.path("scene.json"), desc)?;
@@ -113,8 +162,16 @@ pub fn list_files(dir: &Path, root: &Path) -> Result<Vec<FileEntry>> {
         .map(|p| {
             let (sha256, bytes) = sha256_file(p)?;
             let rel = p.strip_prefix(root).unwrap_or(p);
-            let path = rel.components().map(|c| c.as_os_str().to_string_lossy()).collect::<Vec<_>>().join("/");
-            Ok(FileEntry { path, sha256, bytes })
+            let path = rel
+                .components()
+                .map(|c| c.as_os_str().to_string_lossy())
+                .collect::<Vec<_>>()
+                .join("/");
+            Ok(FileEntry {
+                path,
+                sha256,
+                bytes,
+            })
         })
         .collect()
 }
@@ -124,7 +181,8 @@ fn hci_parameters(desc: &SceneDesc, stats: &SceneStats) -> HciParameters {
     let cam = &desc.camera;
     let [px, py, pz] = cam.blender_position();
     let [rx, ry, rz] = cam.blender_rotation();
-    let (disp_min, disp_max) = hci_disp_bounds(stats.hci_disparity_range[0], stats.hci_disparity_range[1]);
+    let (disp_min, disp_max) =
+        hci_disp_bounds(stats.hci_disparity_range[0], stats.hci_disparity_range[1]);
     HciParameters {
         focal_length_mm: cam.focal_length_mm,
         image_resolution_x_px: cam.resolution[0],

@@ -18,17 +18,27 @@ impl RenderScene {
         let mut hits = Vec::new();
         let (mut near, mut far) = (f32::INFINITY, 0.0f32);
         let last = cam.num_views() - 1;
-        for view in [cam.center_view(), 0, cam.grid[0] - 1, last + 1 - cam.grid[0], last] {
+        for view in [
+            cam.center_view(),
+            0,
+            cam.grid[0] - 1,
+            last + 1 - cam.grid[0],
+            last,
+        ] {
             let rays = cam.view_rays(view);
             for j in 0..PROBE_RES {
                 for i in 0..PROBE_RES {
                     let x = (i as f32 + 0.5) / PROBE_RES as f32 * cam.width() as f32;
                     let y = (j as f32 + 0.5) / PROBE_RES as f32 * cam.height() as f32;
                     let r = rays.ray(x, y);
-                    self.geometry.all_hits(r.origin, r.dir, f32::INFINITY, &mut hits);
+                    self.geometry
+                        .all_hits(r.origin, r.dir, f32::INFINITY, &mut hits);
                     let Some(first) = hits.first() else { continue };
                     near = near.min(first.t);
-                    if let Some(h) = hits.iter().find(|h| self.geometry.coverage(&self.materials, h, r.dir) >= 1.0) {
+                    if let Some(h) = hits
+                        .iter()
+                        .find(|h| self.geometry.coverage(&self.materials, h, r.dir) >= 1.0)
+                    {
                         far = far.max(h.t);
                     }
                 }
@@ -42,15 +52,26 @@ impl RenderScene {
     /// The probed range is widened by 2 % at each end so surfaces between probe rays still fall
     /// inside it; with `baseline = "auto"` that widened range maps exactly onto the configured
     /// disparity range.
-    pub fn frame(&self, cam: &mut LightFieldCamera, cfg: &CameraConfig, slices: u32, spacing: SliceSpacing) -> anyhow::Result<SliceRange> {
-        let (near, far) = self
-            .probe_depth_range(cam)
-            .ok_or_else(|| anyhow::anyhow!("the camera sees no closed geometry: cannot fit a depth range"))?;
+    pub fn frame(
+        &self,
+        cam: &mut LightFieldCamera,
+        cfg: &CameraConfig,
+        slices: u32,
+        spacing: SliceSpacing,
+    ) -> anyhow::Result<SliceRange> {
+        let (near, far) = self.probe_depth_range(cam).ok_or_else(|| {
+            anyhow::anyhow!("the camera sees no closed geometry: cannot fit a depth range")
+        })?;
         let (z_near, z_far) = (near * 0.98, far * 1.02);
         if cfg.baseline == BaselineMode::Auto {
             cam.fit_disparity_range(z_near, z_far, cfg.disparity_range);
         }
-        Ok(SliceRange { z_near, z_far, count: slices, spacing })
+        Ok(SliceRange {
+            z_near,
+            z_far,
+            count: slices,
+            spacing,
+        })
     }
 }
 
@@ -62,6 +83,9 @@ pub fn luminance(c: Vec3) -> f32 {
 /// Exposure mapping the log-average luminance of `pixels` to middle grey (0.18).
 pub fn auto_exposure(pixels: &[Vec3]) -> f32 {
     let n = pixels.len().max(1) as f64;
-    let log_sum: f64 = pixels.iter().map(|&c| (luminance(c) as f64 + 1e-4).ln()).sum();
+    let log_sum: f64 = pixels
+        .iter()
+        .map(|&c| (luminance(c) as f64 + 1e-4).ln())
+        .sum();
     (0.18 / (log_sum / n).exp()) as f32
 }

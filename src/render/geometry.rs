@@ -8,8 +8,8 @@ use crate::scene::shapes::MeshTri;
 use anyhow::{Result, bail};
 use glam::{Vec2, Vec3, Vec3A};
 use obvhs::{
-    BvhBuildParams, cwbvh::CwBvh, cwbvh::builder::build_cwbvh_from_tris, ray::Ray,
-    ray::RayHit, triangle::Triangle,
+    BvhBuildParams, cwbvh::CwBvh, cwbvh::builder::build_cwbvh_from_tris, ray::Ray, ray::RayHit,
+    triangle::Triangle,
 };
 use std::time::Duration;
 
@@ -58,7 +58,10 @@ impl Geometry {
     /// Builds the BVH; rejects non-finite vertices, naming the object.
     pub fn build(tris: &[SceneTri], object_names: &[String]) -> Result<Self> {
         if let Some(bad) = tris.iter().find(|t| !t.tri.p.iter().all(|p| p.is_finite())) {
-            bail!("object {:?} has non-finite vertex coordinates", object_names[bad.object as usize]);
+            bail!(
+                "object {:?} has non-finite vertex coordinates",
+                object_names[bad.object as usize]
+            );
         }
         if tris.is_empty() {
             bail!("the scene has no geometry");
@@ -70,19 +73,37 @@ impl Geometry {
                 Triangle { v0, v1, v2 }
             })
             .collect();
-        let bvh = build_cwbvh_from_tris(&prims, BvhBuildParams::medium_build(), &mut Duration::default());
+        let bvh = build_cwbvh_from_tris(
+            &prims,
+            BvhBuildParams::medium_build(),
+            &mut Duration::default(),
+        );
         let order = bvh.primitive_indices.iter().map(|&i| i as usize);
         let isect = order
             .clone()
-            .map(|i| IsectTri { v0: prims[i].v0, e1: prims[i].v1 - prims[i].v0, e2: prims[i].v2 - prims[i].v0 })
+            .map(|i| IsectTri {
+                v0: prims[i].v0,
+                e1: prims[i].v1 - prims[i].v0,
+                e2: prims[i].v2 - prims[i].v0,
+            })
             .collect();
         let shading = order
             .map(|i| {
                 let t = &tris[i];
-                TriShading { n: t.tri.n, uv: t.tri.uv, material: t.material, object: t.object, id: i as u32 }
+                TriShading {
+                    n: t.tri.n,
+                    uv: t.tri.uv,
+                    material: t.material,
+                    object: t.object,
+                    id: i as u32,
+                }
             })
             .collect();
-        Ok(Self { bvh, isect, shading })
+        Ok(Self {
+            bvh,
+            isect,
+            shading,
+        })
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -129,7 +150,18 @@ impl Geometry {
     pub fn shading_normal(&self, hit: &Hit) -> Vec3 {
         let s = &self.shading[hit.tri as usize];
         let n = s.n[0] * (1.0 - hit.b.x - hit.b.y) + s.n[1] * hit.b.x + s.n[2] * hit.b.y;
-        n.try_normalize().unwrap_or_else(|| self.geometric_normal(hit.tri))
+        n.try_normalize()
+            .unwrap_or_else(|| self.geometric_normal(hit.tri))
+    }
+
+    /// Distance along `dir` from `origin` to the plane of triangle `tri` (None when parallel).
+    #[inline]
+    pub fn plane_distance(&self, tri: u32, origin: Vec3, dir: Vec3) -> Option<f32> {
+        let t = &self.isect[tri as usize];
+        let n = Vec3::from(t.e1.cross(t.e2));
+        let denom = n.dot(dir);
+        (denom.abs() > 1e-12 * n.length() * dir.length())
+            .then(|| n.dot(Vec3::from(t.v0) - origin) / denom)
     }
 
     /// Area and vertices of a triangle (light sampling).
@@ -142,7 +174,8 @@ impl Geometry {
     #[inline]
     fn opacity(&self, mats: &[RenderMaterial], hit: &Hit) -> f32 {
         let m = &mats[self.shading[hit.tri as usize].material as usize];
-        m.uniform_opacity.unwrap_or_else(|| m.opacity.eval(self.uv(hit)))
+        m.uniform_opacity
+            .unwrap_or_else(|| m.opacity.eval(self.uv(hit)))
     }
 
     /// Whether the stochastic-transparency test keeps this hit. The decision hashes the ray's
@@ -150,18 +183,34 @@ impl Geometry {
     #[inline]
     pub fn accepts(&self, mats: &[RenderMaterial], hit: &Hit, key: u64) -> bool {
         let a = self.opacity(mats, hit);
-        a >= 1.0 || (a > 0.0 && unit_float(mix64(key ^ self.shading[hit.tri as usize].id as u64)) < a)
+        a >= 1.0
+            || (a > 0.0 && unit_float(mix64(key ^ self.shading[hit.tri as usize].id as u64)) < a)
     }
 
     /// Closest hit that passes the stochastic-transparency test for `key`.
-    pub fn closest(&self, mats: &[RenderMaterial], origin: Vec3, dir: Vec3, tmax: f32, key: u64) -> Option<Hit> {
+    pub fn closest(
+        &self,
+        mats: &[RenderMaterial],
+        origin: Vec3,
+        dir: Vec3,
+        tmax: f32,
+        key: u64,
+    ) -> Option<Hit> {
         let ray = Ray::new(origin.into(), dir.into(), 0.0, tmax);
-        let mut best = Hit { t: f32::INFINITY, tri: 0, b: Vec2::ZERO };
+        let mut best = Hit {
+            t: f32::INFINITY,
+            tri: 0,
+            b: Vec2::ZERO,
+        };
         let mut rh = RayHit::none();
         self.bvh.ray_traverse(ray, &mut rh, |r, leaf| {
             let (t, b) = self.intersect(r, leaf);
             if t < best.t {
-                let hit = Hit { t, tri: leaf as u32, b };
+                let hit = Hit {
+                    t,
+                    tri: leaf as u32,
+                    b,
+                };
                 if self.accepts(mats, &hit, key) {
                     best = hit;
                     return t;
@@ -180,7 +229,11 @@ impl Geometry {
         self.bvh.ray_traverse_anyhit(ray, |r, leaf| {
             let (t, b) = self.intersect(r, leaf);
             if t.is_finite() {
-                out.push(Hit { t, tri: leaf as u32, b });
+                out.push(Hit {
+                    t,
+                    tri: leaf as u32,
+                    b,
+                });
             }
         });
         out.sort_unstable_by(|a, b| a.t.total_cmp(&b.t).then(a.tri.cmp(&b.tri)));
@@ -192,15 +245,29 @@ impl Geometry {
 
     /// Fraction of light passing from `origin` along `dir` to distance `tmax`: the product of
     /// `1 - opacity` over semi-transparent surfaces; opaque surfaces and glass block.
-    pub fn transmittance(&self, mats: &[RenderMaterial], origin: Vec3, dir: Vec3, tmax: f32) -> f32 {
+    pub fn transmittance(
+        &self,
+        mats: &[RenderMaterial],
+        origin: Vec3,
+        dir: Vec3,
+        tmax: f32,
+    ) -> f32 {
         let ray = Ray::new(origin.into(), dir.into(), 0.0, tmax);
         let mut tr = 1.0f32;
         let clear = self.bvh.ray_traverse_miss(ray, |r, leaf| {
             let (t, b) = self.intersect(r, leaf);
             if t.is_finite() {
-                let hit = Hit { t, tri: leaf as u32, b };
+                let hit = Hit {
+                    t,
+                    tri: leaf as u32,
+                    b,
+                };
                 let m = &mats[self.shading[leaf].material as usize];
-                let a = if m.glass_ior.is_some() { 1.0 } else { self.opacity(mats, &hit) };
+                let a = if m.glass_ior.is_some() {
+                    1.0
+                } else {
+                    self.opacity(mats, &hit)
+                };
                 if a >= 1.0 {
                     return t;
                 }

@@ -38,7 +38,10 @@ impl RenderScene {
         let (mut origin, mut dir, mut hit) = (origin, dir, first);
         let mut radiance = Vec3::ZERO;
         let mut beta = Vec3::ONE;
-        let mut arrival = Arrival { pdf: 0.0, is_delta: true };
+        let mut arrival = Arrival {
+            pdf: 0.0,
+            is_delta: true,
+        };
         for depth in 0..settings.max_depth {
             let Some(h) = hit else {
                 radiance += beta * self.environment;
@@ -55,22 +58,33 @@ impl RenderScene {
             if !bsdf.is_delta() && !self.lights.is_empty() {
                 radiance += beta * self.direct_light(p, &h, &frame, wo_l, &bsdf, sampler);
             }
-            let Some(bs) = bsdf.sample(wo_l, sampler.next(), sampler.next2()) else { break };
+            let Some(bs) = bsdf.sample(wo_l, sampler.next_f32(), sampler.next2()) else {
+                break;
+            };
             if bs.pdf <= 0.0 {
                 break;
             }
             beta *= bs.f * bs.wi.z.abs() / bs.pdf;
-            arrival = Arrival { pdf: bs.pdf, is_delta: bs.is_delta };
+            arrival = Arrival {
+                pdf: bs.pdf,
+                is_delta: bs.is_delta,
+            };
             if depth + 1 >= settings.rr_depth {
                 let survive = beta.max_element().min(0.95);
-                if sampler.next() >= survive {
+                if sampler.next_f32() >= survive {
                     break;
                 }
                 beta /= survive;
             }
             dir = frame.to_world(bs.wi);
             origin = self.spawn(p, h.tri, dir);
-            hit = self.geometry.closest(&self.materials, origin, dir, f32::INFINITY, sampler.next_key());
+            hit = self.geometry.closest(
+                &self.materials,
+                origin,
+                dir,
+                f32::INFINITY,
+                sampler.next_key(),
+            );
         }
         radiance
     }
@@ -103,7 +117,12 @@ impl RenderScene {
         bsdf: &super::bsdf::SurfaceParams,
         sampler: &mut Sampler,
     ) -> Vec3 {
-        let ls = self.lights.sample(&self.geometry, &self.materials, sampler.next(), sampler.next2());
+        let ls = self.lights.sample(
+            &self.geometry,
+            &self.materials,
+            sampler.next_f32(),
+            sampler.next2(),
+        );
         let to_light = ls.p - p;
         let dist = to_light.length();
         let wi = to_light / dist;
@@ -118,7 +137,9 @@ impl RenderScene {
         }
         let origin = self.spawn(p, h.tri, wi);
         let tmax = (ls.p - origin).length() * (1.0 - 1e-3);
-        let tr = self.geometry.transmittance(&self.materials, origin, wi, tmax);
+        let tr = self
+            .geometry
+            .transmittance(&self.materials, origin, wi, tmax);
         if tr <= 0.0 {
             return Vec3::ZERO;
         }

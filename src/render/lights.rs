@@ -54,13 +54,25 @@ impl Lights {
 
     /// Samples a point on a light with one number for the triangle and two for the point.
     pub fn sample(&self, geo: &Geometry, mats: &[RenderMaterial], u: f32, uv: Vec2) -> LightSample {
-        let k = self.cdf.partition_point(|&c| c <= u).min(self.tris.len() - 1);
+        let k = self
+            .cdf
+            .partition_point(|&c| c <= u)
+            .min(self.tris.len() - 1);
         let tri = self.tris[k];
         let v = geo.vertices(tri);
-        let (su, sv) = if uv.x + uv.y > 1.0 { (1.0 - uv.x, 1.0 - uv.y) } else { (uv.x, uv.y) };
+        let (su, sv) = if uv.x + uv.y > 1.0 {
+            (1.0 - uv.x, 1.0 - uv.y)
+        } else {
+            (uv.x, uv.y)
+        };
         let p = v[0] + (v[1] - v[0]) * su + (v[2] - v[0]) * sv;
         let emission = mats[geo.shading[tri as usize].material as usize].emission;
-        LightSample { p, n: geo.geometric_normal(tri), emission, pdf_area: self.pmf[tri as usize] / area(&v) }
+        LightSample {
+            p,
+            n: geo.geometric_normal(tri),
+            emission,
+            pdf_area: self.pmf[tri as usize] / area(&v),
+        }
     }
 
     /// Solid-angle pdf with which [`Self::sample`] would pick this point of triangle `tri`,

@@ -43,12 +43,22 @@ impl RenderScene {
             );
             mesh.clear();
             tessellate(&obj.shape, &obj.transform, &mut mesh);
-            tris.extend(mesh.iter().map(|&tri| SceneTri { tri, material: obj.material, object: i as u32 }));
+            tris.extend(mesh.iter().map(|&tri| SceneTri {
+                tri,
+                material: obj.material,
+                object: i as u32,
+            }));
         }
         let names: Vec<String> = desc.objects.iter().map(|o| o.name.clone()).collect();
         let geometry = Geometry::build(&tris, &names)?;
-        let materials: Vec<RenderMaterial> = desc.materials.iter().map(RenderMaterial::new).collect();
+        let materials: Vec<RenderMaterial> =
+            desc.materials.iter().map(RenderMaterial::new).collect();
         let lights = Lights::new(&geometry, &materials);
-        Ok(Self { geometry, materials, lights, environment: Vec3::from(desc.environment) })
+        Ok(Self {
+            geometry,
+            materials,
+            lights,
+            environment: Vec3::from(desc.environment),
+        })
     }
 }

@@ -34,23 +34,29 @@ impl Sampler {
         let key = mix64(mix64(mix64(seed) ^ scene) ^ view as u64);
         let pixel = (y as u64) << 32 | x as u64;
         let nx = (spp as f64).sqrt().round().max(1.0) as u32;
-        Self { rng: Pcg32::new(mix64(key ^ pixel), key | 1), strata: [nx, spp.div_ceil(nx)] }
+        Self {
+            rng: Pcg32::new(mix64(key ^ pixel), key | 1),
+            strata: [nx, spp.div_ceil(nx)],
+        }
     }
 
     /// An independent stream keyed by a 64-bit value (side computations that must not shift
     /// the pixel's own stream, such as shading hidden slice surfaces).
     pub fn from_key(key: u64) -> Self {
-        Self { rng: Pcg32::new(mix64(key), mix64(!key) | 1), strata: [1, 1] }
+        Self {
+            rng: Pcg32::new(mix64(key), mix64(!key) | 1),
+            strata: [1, 1],
+        }
     }
 
     #[inline]
-    pub fn next(&mut self) -> f32 {
+    pub fn next_f32(&mut self) -> f32 {
         self.rng.random::<f32>()
     }
 
     #[inline]
     pub fn next2(&mut self) -> Vec2 {
-        Vec2::new(self.next(), self.next())
+        Vec2::new(self.next_f32(), self.next_f32())
     }
 
     /// A fresh 64-bit key (per-ray decisions that must not depend on traversal order).
@@ -74,9 +80,15 @@ mod tests {
 
     #[test]
     fn streams_are_reproducible_and_distinct() {
-        let a: Vec<f32> = (0..8).scan(Sampler::new(1, 2, 3, 4, 5, 16), |s, _| Some(s.next())).collect();
-        let b: Vec<f32> = (0..8).scan(Sampler::new(1, 2, 3, 4, 5, 16), |s, _| Some(s.next())).collect();
-        let c: Vec<f32> = (0..8).scan(Sampler::new(1, 2, 3, 5, 4, 16), |s, _| Some(s.next())).collect();
+        let a: Vec<f32> = (0..8)
+            .scan(Sampler::new(1, 2, 3, 4, 5, 16), |s, _| Some(s.next_f32()))
+            .collect();
+        let b: Vec<f32> = (0..8)
+            .scan(Sampler::new(1, 2, 3, 4, 5, 16), |s, _| Some(s.next_f32()))
+            .collect();
+        let c: Vec<f32> = (0..8)
+            .scan(Sampler::new(1, 2, 3, 5, 4, 16), |s, _| Some(s.next_f32()))
+            .collect();
         assert_eq!(a, b);
         assert_ne!(a, c);
     }

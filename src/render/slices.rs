@@ -7,13 +7,13 @@
 //! `η_exact` sums `T·a` per hit (T the transmittance in front of it, per sample): the exact
 //! visible fraction that the over operator approximates when coverages are correlated.
 
-use crate::scene::SliceRange;
 use glam::Vec3;
 use lfformat::Mode;
 
-/// One surface along a sample ray: planar depth and coverage in [0, 1].
+/// One surface along a sample ray: its slice, planar depth and coverage in [0, 1].
 #[derive(Clone, Copy, Debug)]
 pub struct SliceHit {
+    pub slice: u32,
     pub z: f32,
     pub coverage: f32,
     /// Radiance leaving the surface towards the camera, when every hit is shaded
@@ -30,6 +30,11 @@ pub struct SliceAccumulator {
     color_weight: Vec<f32>,
     touched: Vec<u32>,
     marked: Vec<bool>,
+    /// In-slice transmittance of the current sample, and the slices it touched.
+    sample_t: Vec<f32>,
+    sample_touched: Vec<u32>,
+    /// The pixel's modes before sorting by depth.
+    pixel_modes: Vec<(Mode, [f32; 3])>,
     samples: u32,
 }
 
@@ -49,6 +54,9 @@ impl SliceAccumulator {
             color_weight: vec![0.0; slices],
             touched: Vec::with_capacity(slices),
             marked: vec![false; slices],
+            sample_t: vec![1.0; slices],
+            sample_touched: Vec::with_capacity(slices),
+            pixel_modes: Vec::new(),
             samples: 0,
         }
     }
@@ -60,43 +68,48 @@ impl SliceAccumulator {
         }
     }
 
-    /// Adds one sample ray's hits (sorted front to back).
-    pub fn add_sample(&mut self, range: &SliceRange, hits: &[SliceHit]) {
+    /// Adds one sample ray's hits (sorted front to back). Within a slice, hits composite over
+    /// each other in ray order; slices need not be monotone along the ray.
+    pub fn add_sample(&mut self, hits: &[SliceHit]) {
         self.samples += 1;
         let mut transmittance = 1.0f32;
-        let mut i = 0;
-        while i < hits.len() {
-            let k = range.index(hits[i].z);
+        for h in hits {
+            let k = h.slice as usize;
             self.touch(k);
-            let mut slice_t = 1.0f32;
-            while i < hits.len() && range.index(hits[i].z) == k {
-                let a = hits[i].coverage;
-                self.alpha_z[k] += (slice_t * a) as f64 * hits[i].z as f64;
-                if let Some(radiance) = hits[i].radiance {
-                    self.color[k] += radiance * (slice_t * a);
-                    self.color_weight[k] += slice_t * a;
-                }
-                self.exact[k] += transmittance * a;
-                slice_t *= 1.0 - a;
-                transmittance *= 1.0 - a;
-                i += 1;
+            if !self.sample_touched.contains(&h.slice) {
+                self.sample_touched.push(h.slice);
             }
-            self.alpha[k] += 1.0 - slice_t;
+            let w = self.sample_t[k] * h.coverage;
+            self.alpha_z[k] += w as f64 * h.z as f64;
+            if let Some(radiance) = h.radiance {
+                self.color[k] += radiance * w;
+                self.color_weight[k] += w;
+            }
+            self.exact[k] += transmittance * h.coverage;
+            self.sample_t[k] *= 1.0 - h.coverage;
+            transmittance *= 1.0 - h.coverage;
         }
+        for &k in &self.sample_touched {
+            self.alpha[k as usize] += 1.0 - self.sample_t[k as usize];
+            self.sample_t[k as usize] = 1.0;
+        }
+        self.sample_touched.clear();
     }
 
     /// Attributes a sample's radiance to the slice of the surface it saw (slice colours at no
     /// extra shading cost; `weight` is 1 for the visible hit, or the hit's in-slice over weight
     /// when every hit is shaded).
-    pub fn add_color(&mut self, range: &SliceRange, z: f32, radiance: Vec3, weight: f32) {
-        let k = range.index(z);
+    pub fn add_color(&mut self, slice: u32, radiance: Vec3, weight: f32) {
+        let k = slice as usize;
         self.touch(k);
         self.color[k] += radiance * weight;
         self.color_weight[k] += weight;
     }
 
-    /// Composites the pixel's slices and appends its modes (η or η_exact above `epsilon`) and
-    /// their colours; resets the accumulators for the next pixel.
+    /// Composites the pixel's slices front to back and appends its modes (η or η_exact above
+    /// `epsilon`) and their colours, sorted by depth; resets the accumulators for the next
+    /// pixel. (Slice order and depth order differ only where two surfaces of neighbouring
+    /// slices interleave inside one pixel, at creases.)
     pub fn finish_pixel(
         &mut self,
         disparity: impl Fn(f64) -> f64,
@@ -116,9 +129,20 @@ impl SliceAccumulator {
             if (eta > epsilon || eta_exact > epsilon) && self.alpha[k] > 0.0 {
                 let z = self.alpha_z[k] / self.alpha[k] as f64;
                 let d = disparity(z) as f32;
-                modes.push(Mode { disparity: d, depth: z as f32, eta, eta_exact });
-                let c = if self.color_weight[k] > 0.0 { self.color[k] / self.color_weight[k] } else { Vec3::ZERO };
-                colors.push(c.to_array());
+                let c = if self.color_weight[k] > 0.0 {
+                    self.color[k] / self.color_weight[k]
+                } else {
+                    Vec3::ZERO
+                };
+                self.pixel_modes.push((
+                    Mode {
+                        disparity: d,
+                        depth: z as f32,
+                        eta,
+                        eta_exact,
+                    },
+                    c.to_array(),
+                ));
             }
             self.alpha[k] = 0.0;
             self.alpha_z[k] = 0.0;
@@ -127,6 +151,11 @@ impl SliceAccumulator {
             self.color_weight[k] = 0.0;
             self.marked[k] = false;
         }
+        self.pixel_modes
+            .sort_by(|a, b| a.0.depth.total_cmp(&b.0.depth));
+        modes.extend(self.pixel_modes.iter().map(|m| m.0));
+        colors.extend(self.pixel_modes.iter().map(|m| m.1));
+        self.pixel_modes.clear();
         self.touched.clear();
         self.samples = 0;
     }
@@ -136,21 +165,38 @@ impl SliceAccumulator {
 mod tests {
     use super::*;
     use crate::config::SliceSpacing;
+    use crate::scene::SliceRange;
 
     fn range() -> SliceRange {
-        SliceRange { z_near: 1.0, z_far: 9.0, count: 8, spacing: SliceSpacing::Depth }
+        SliceRange {
+            z_near: 1.0,
+            z_far: 9.0,
+            count: 8,
+            spacing: SliceSpacing::Depth,
+        }
     }
 
     fn hit(z: f32, coverage: f32) -> SliceHit {
-        SliceHit { z, coverage, radiance: None }
+        SliceHit {
+            slice: range().index(z) as u32,
+            z,
+            coverage,
+            radiance: None,
+        }
     }
 
     #[test]
     fn shaded_hits_give_over_weighted_slice_colours() {
         let mut acc = SliceAccumulator::new(8);
-        let red = SliceHit { z: 2.2, coverage: 0.5, radiance: Some(Vec3::X) };
-        let blue = SliceHit { z: 2.8, coverage: 1.0, radiance: Some(Vec3::Z) };
-        acc.add_sample(&range(), &[red, blue]);
+        let red = SliceHit {
+            radiance: Some(Vec3::X),
+            ..hit(2.2, 0.5)
+        };
+        let blue = SliceHit {
+            radiance: Some(Vec3::Z),
+            ..hit(2.8, 1.0)
+        };
+        acc.add_sample(&[red, blue]);
         let (mut m, mut c) = (Vec::new(), Vec::new());
         acc.finish_pixel(|z| 1.0 / z, 1e-4, &mut m, &mut c);
         // Weights 0.5 (red) and 0.5 (blue behind it): the straight colour is their mean.
@@ -167,7 +213,7 @@ mod tests {
     fn pane_over_wall_gives_two_modes_by_hand() {
         let mut acc = SliceAccumulator::new(8);
         let hits = [hit(2.5, 0.4), hit(7.5, 1.0)];
-        acc.add_sample(&range(), &hits);
+        acc.add_sample(&hits);
         let m = finish(&mut acc);
         assert_eq!(m.len(), 2);
         assert!((m[0].eta - 0.4).abs() < 1e-6 && (m[1].eta - 0.6).abs() < 1e-6);
@@ -180,7 +226,7 @@ mod tests {
     fn hits_in_one_slice_composite_over_each_other() {
         let mut acc = SliceAccumulator::new(8);
         let hits = [hit(2.2, 0.5), hit(2.8, 0.5)];
-        acc.add_sample(&range(), &hits);
+        acc.add_sample(&hits);
         let m = finish(&mut acc);
         // α = 1 - 0.5·0.5 = 0.75; depth = (0.5·2.2 + 0.25·2.8) / 0.75.
         assert_eq!(m.len(), 1);
@@ -194,8 +240,8 @@ mod tests {
         // see the wall. Over: α = ½, ½ → η = ½, ¼, ¼. Exact: ½, ½, 0.
         let mut acc = SliceAccumulator::new(8);
         let wall = hit(8.5, 1.0);
-        acc.add_sample(&range(), &[hit(1.5, 1.0), wall]);
-        acc.add_sample(&range(), &[hit(4.5, 1.0), wall]);
+        acc.add_sample(&[hit(1.5, 1.0), wall]);
+        acc.add_sample(&[hit(4.5, 1.0), wall]);
         let m = finish(&mut acc);
         let eta: Vec<f32> = m.iter().map(|m| m.eta).collect();
         let exact: Vec<f32> = m.iter().map(|m| m.eta_exact).collect();
@@ -204,12 +250,29 @@ mod tests {
     }
 
     #[test]
+    fn a_slice_revisited_along_the_ray_composites_once() {
+        // Slices 1, 5, 1 along the ray (intersecting surfaces): slice 1 gets α = 1 - 0.5·0.5.
+        let mut acc = SliceAccumulator::new(8);
+        let h = |slice, z| SliceHit {
+            slice,
+            z,
+            coverage: 0.5,
+            radiance: None,
+        };
+        acc.add_sample(&[h(1, 2.0), h(5, 2.1), h(1, 2.2)]);
+        let m = finish(&mut acc);
+        assert_eq!(m.len(), 2);
+        assert!((m[0].eta - 0.75).abs() < 1e-6 && (m[1].eta - 0.5 * 0.25).abs() < 1e-6);
+        assert!((m[0].eta_exact - 0.625).abs() < 1e-6 && (m[1].eta_exact - 0.25).abs() < 1e-6);
+    }
+
+    #[test]
     fn occluded_slices_are_dropped_and_state_resets() {
         let mut acc = SliceAccumulator::new(8);
         let hits = [hit(1.5, 1.0), hit(8.5, 1.0)];
-        acc.add_sample(&range(), &hits);
+        acc.add_sample(&hits);
         assert_eq!(finish(&mut acc).len(), 1);
-        acc.add_sample(&range(), &[hit(5.5, 1.0)]);
+        acc.add_sample(&[hit(5.5, 1.0)]);
         let m = finish(&mut acc);
         assert_eq!(m.len(), 1);
         assert_eq!(m[0].depth, 5.5);

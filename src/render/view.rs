@@ -24,6 +24,8 @@ pub struct RenderSettings {
     /// Shade every hit of GT rays, so mode colours are true slice colours (else each sample's
     /// colour goes to the slice of the surface it saw).
     pub shade_all_hits: bool,
+    /// Slice by the surface's depth at the pixel centre (else by the sample's hit depth).
+    pub slice_by_surface: bool,
 }
 
 /// Linear radiance, row-major from the top-left.
@@ -84,13 +86,26 @@ impl RenderScene {
         let bands: Vec<Band> = (0..h.div_ceil(BAND_ROWS))
             .into_par_iter()
             .map_init(
-                || Scratch { hits: Vec::new(), slice_hits: Vec::new(), acc: SliceAccumulator::new(slices.count as usize) },
+                || Scratch {
+                    hits: Vec::new(),
+                    slice_hits: Vec::new(),
+                    acc: SliceAccumulator::new(slices.count as usize),
+                },
                 |scratch, b| {
                     let rows = b * BAND_ROWS..((b + 1) * BAND_ROWS).min(h);
                     let mut band = Band::default();
                     for y in rows {
                         for x in 0..w {
-                            let ctx = PixelCtx { scene: self, cam, rays: &rays, slices, settings, view, x, y };
+                            let ctx = PixelCtx {
+                                scene: self,
+                                cam,
+                                rays: &rays,
+                                slices,
+                                settings,
+                                view,
+                                x,
+                                y,
+                            };
                             ctx.render(with_gt, scratch, &mut band);
                         }
                         samples_done.fetch_add(w as u64 * settings.spp as u64, Ordering::Relaxed);
@@ -118,8 +133,19 @@ fn assemble(width: usize, height: usize, bands: Vec<Band>, with_gt: bool) -> Vie
         colors.extend(band.colors);
         hci_depth.extend(band.hci_depth);
     }
-    let gt = with_gt.then_some(ViewGt { modes, colors, hci_depth });
-    ViewOutput { image: ViewImage { width, height, pixels }, gt }
+    let gt = with_gt.then_some(ViewGt {
+        modes,
+        colors,
+        hci_depth,
+    });
+    ViewOutput {
+        image: ViewImage {
+            width,
+            height,
+            pixels,
+        },
+        gt,
+    }
 }
 
 /// One pixel's render inputs.
@@ -146,15 +172,27 @@ impl PixelCtx<'_> {
             sum += if with_gt {
                 self.sample_with_gt(ray.origin, ray.dir, key, &mut sampler, scratch)
             } else {
-                let first = self.scene.geometry.closest(&self.scene.materials, ray.origin, ray.dir, f32::INFINITY, key);
-                self.scene.radiance(&s.path, ray.origin, ray.dir, first, &mut sampler)
+                let first = self.scene.geometry.closest(
+                    &self.scene.materials,
+                    ray.origin,
+                    ray.dir,
+                    f32::INFINITY,
+                    key,
+                );
+                self.scene
+                    .radiance(&s.path, ray.origin, ray.dir, first, &mut sampler)
             };
         }
         band.pixels.push(sum / s.spp as f32);
         if with_gt {
             let before = band.modes.len();
             let cam = self.cam;
-            scratch.acc.finish_pixel(|z| cam.disparity(z), s.mode_epsilon, &mut band.modes, &mut band.colors);
+            scratch.acc.finish_pixel(
+                |z| cam.disparity(z),
+                s.mode_epsilon,
+                &mut band.modes,
+                &mut band.colors,
+            );
             band.mode_counts.push((band.modes.len() - before) as u32);
             band.hci_depth.push(self.hci_depth(scratch));
         }
@@ -163,7 +201,15 @@ impl PixelCtx<'_> {
     /// Collects every hit of a sample ray into the slice accumulator and returns the radiance
     /// of the surface the colour path continues from (the first kept by stochastic
     /// transparency), exactly as the colour-only path would.
-    fn sample_with_gt(&self, origin: Vec3, dir: Vec3, key: u64, sampler: &mut Sampler, scratch: &mut Scratch) -> Vec3 {
+    fn sample_with_gt(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        key: u64,
+        sampler: &mut Sampler,
+        scratch: &mut Scratch,
+    ) -> Vec3 {
+        let centre = self.rays.ray(self.x as f32 + 0.5, self.y as f32 + 0.5);
         let (scene, geo, mats) = (self.scene, &self.scene.geometry, &self.scene.materials);
         geo.all_hits(origin, dir, f32::INFINITY, &mut scratch.hits);
         let first = scratch.hits.iter().position(|h| geo.accepts(mats, h, key));
@@ -174,16 +220,47 @@ impl PixelCtx<'_> {
             let shaded = match self.settings.shade_all_hits {
                 true if Some(i) == first => Some(radiance),
                 // Hidden surfaces draw from their own stream so the colour image stays the same.
-                true => Some(scene.radiance(path, origin, dir, Some(*h), &mut Sampler::from_key(key ^ i as u64))),
+                true => Some(scene.radiance(
+                    path,
+                    origin,
+                    dir,
+                    Some(*h),
+                    &mut Sampler::from_key(key ^ i as u64),
+                )),
                 false => None,
             };
-            scratch.slice_hits.push(SliceHit { z: h.t, coverage: geo.coverage(mats, h, dir), radiance: shaded });
+            let slice = self.slice_of(h, centre.origin, centre.dir);
+            scratch.slice_hits.push(SliceHit {
+                slice,
+                z: h.t,
+                coverage: geo.coverage(mats, h, dir),
+                radiance: shaded,
+            });
         }
-        scratch.acc.add_sample(self.slices, &scratch.slice_hits);
+        scratch.acc.add_sample(&scratch.slice_hits);
         if let (false, Some(i)) = (self.settings.shade_all_hits, first) {
-            scratch.acc.add_color(self.slices, scratch.hits[i].t, radiance, 1.0);
+            scratch
+                .acc
+                .add_color(scratch.slice_hits[i].slice, radiance, 1.0);
         }
         radiance
+    }
+
+    /// Slice of a hit: by its surface's depth on the pixel-centre ray (falling back to the hit
+    /// depth for surfaces seen nearly edge-on), or by the hit depth itself.
+    fn slice_of(&self, h: &Hit, origin: Vec3, centre_dir: Vec3) -> u32 {
+        let surface = || {
+            self.scene
+                .geometry
+                .plane_distance(h.tri, origin, centre_dir)
+        };
+        let z = match self.settings.slice_by_surface {
+            true => surface()
+                .filter(|z| *z > 0.5 * h.t && *z < 2.0 * h.t)
+                .unwrap_or(h.t),
+            false => h.t,
+        };
+        self.slices.index(z) as u32
     }
 
     /// HCI semantics: depth of the first surface with coverage ≥ 0.5 on the pixel-centre ray.
@@ -191,7 +268,10 @@ impl PixelCtx<'_> {
         let (geo, mats) = (&self.scene.geometry, &self.scene.materials);
         let ray = self.rays.ray(self.x as f32 + 0.5, self.y as f32 + 0.5);
         geo.all_hits(ray.origin, ray.dir, f32::INFINITY, &mut scratch.hits);
-        let first = scratch.hits.iter().find(|h| geo.coverage(mats, h, ray.dir) >= 0.5);
+        let first = scratch
+            .hits
+            .iter()
+            .find(|h| geo.coverage(mats, h, ray.dir) >= 0.5);
         first.map_or(f32::NAN, |h| h.t)
     }
 }

@@ -4,7 +4,9 @@
 //! Everything is drawn from one RNG stream per (seed, scene index), so a scene is a pure
 //! function of the config.
 
-use super::{Material, Object, Opacity, SceneDesc, Shape, SliceRange, SurfaceModel, Texture, Transform};
+use super::{
+    Material, Object, Opacity, SceneDesc, Shape, SliceRange, SurfaceModel, Texture, Transform,
+};
 use crate::camera::LightFieldCamera;
 use crate::config::Config;
 use crate::render::sampler::mix64;
@@ -16,16 +18,23 @@ use std::f32::consts::{FRAC_PI_2, TAU};
 /// Generates scene `index` of the dataset described by `cfg`. The camera's baseline, focus and
 /// the slice range are provisional until the renderer frames the scene.
 pub fn generate(cfg: &Config, index: u64) -> SceneDesc {
-    let mut g = Gen { rng: Pcg32::new(mix64(cfg.dataset.seed ^ mix64(index)), 0x5CE7E), cfg, materials: Vec::new(), objects: Vec::new() };
+    let mut g = Gen {
+        rng: Pcg32::new(mix64(cfg.dataset.seed ^ mix64(index)), 0x5CE7E),
+        cfg,
+        materials: Vec::new(),
+        objects: Vec::new(),
+    };
     let s = &cfg.scene;
-    let size = Vec3::new(g.range(s.room_width), g.range(s.room_height), g.range(s.room_depth));
+    let size = Vec3::new(
+        g.range(s.room_width),
+        g.range(s.room_height),
+        g.range(s.room_depth),
+    );
     g.room(size);
     g.lights(size);
     let camera = g.camera(size);
-    // Keep the first 2 m in front of the camera free: a pane right at the lens would fill the view.
-    let free_z = size.z / 2.0 - 2.0;
     for _ in 0..s.objects {
-        g.furniture(size, free_z);
+        g.furniture(size, &camera);
     }
     SceneDesc {
         generator: format!("lfgen {}", env!("CARGO_PKG_VERSION")),
@@ -33,7 +42,12 @@ pub fn generate(cfg: &Config, index: u64) -> SceneDesc {
         index,
         seed: cfg.dataset.seed,
         camera,
-        slices: SliceRange { z_near: 0.1, z_far: 100.0, count: cfg.render.slices, spacing: cfg.render.slice_spacing },
+        slices: SliceRange {
+            z_near: 0.1,
+            z_far: 100.0,
+            count: cfg.render.slices,
+            spacing: cfg.render.slice_spacing,
+        },
         environment: s.environment.map(|v| v as f32),
         exposure: cfg.render.exposure as f32,
         materials: g.materials,
@@ -70,9 +84,22 @@ impl Gen<'_> {
         let (a, b) = (self.color(), self.color());
         match self.rng.random_range(0..4) {
             0 => Texture::constant(a),
-            1 => Texture::Checker { a, b, size: 0.05 + 0.3 * self.unit() },
-            2 => Texture::Stripes { a, b, width: 0.02 + 0.15 * self.unit() },
-            _ => Texture::Noise { a, b, scale: 0.03 + 0.3 * self.unit(), seed: self.rng.random() },
+            1 => Texture::Checker {
+                a,
+                b,
+                size: 0.05 + 0.3 * self.unit(),
+            },
+            2 => Texture::Stripes {
+                a,
+                b,
+                width: 0.02 + 0.15 * self.unit(),
+            },
+            _ => Texture::Noise {
+                a,
+                b,
+                scale: 0.03 + 0.3 * self.unit(),
+                seed: self.rng.random(),
+            },
         }
     }
 
@@ -81,7 +108,11 @@ impl Gen<'_> {
         let m = Material {
             name: name.into(),
             model,
-            base_color: if model == SurfaceModel::Standard { self.texture() } else { Texture::constant([0.95; 3]) },
+            base_color: if model == SurfaceModel::Standard {
+                self.texture()
+            } else {
+                Texture::constant([0.95; 3])
+            },
             roughness: 0.15 + 0.8 * self.unit(),
             metallic,
             opacity,
@@ -96,14 +127,27 @@ impl Gen<'_> {
         let s = &self.cfg.scene;
         let (glass, semi, range) = (s.glass, s.semi_transparent, s.opacity_range);
         if self.chance(glass) {
-            return self.material(name, Opacity::constant(1.0), SurfaceModel::Glass { ior: 1.5 });
+            return self.material(
+                name,
+                Opacity::constant(1.0),
+                SurfaceModel::Glass { ior: 1.5 },
+            );
         }
-        let a = if self.chance(semi) { self.range(range) } else { 1.0 };
+        let a = if self.chance(semi) {
+            self.range(range)
+        } else {
+            1.0
+        };
         self.material(name, Opacity::constant(a), SurfaceModel::Standard)
     }
 
     fn add(&mut self, name: &str, shape: Shape, transform: Transform, material: u32) {
-        self.objects.push(Object { name: name.into(), shape, transform, material });
+        self.objects.push(Object {
+            name: name.into(),
+            shape,
+            transform,
+            material,
+        });
     }
 
     fn room(&mut self, size: Vec3) {
@@ -115,7 +159,11 @@ impl Gen<'_> {
         for i in 0..self.cfg.scene.lights {
             let warmth = self.unit();
             let power = 8.0 + 8.0 * self.unit();
-            let emission = [power, power * (0.85 + 0.1 * warmth), power * (0.65 + 0.3 * warmth)];
+            let emission = [
+                power,
+                power * (0.85 + 0.1 * warmth),
+                power * (0.65 + 0.3 * warmth),
+            ];
             self.materials.push(Material {
                 name: format!("light_{i}"),
                 model: SurfaceModel::Standard,
@@ -130,7 +178,12 @@ impl Gen<'_> {
             let x = (self.unit() - 0.5) * size.x * 0.5;
             let mut xf = Transform::at(Vec3::new(x, size.y - 0.02, z));
             xf.rotation = Quat::from_rotation_x(FRAC_PI_2);
-            self.add(&format!("light_{i}"), Shape::Quad { size: [0.8, 0.8] }, xf, m);
+            self.add(
+                &format!("light_{i}"),
+                Shape::Quad { size: [1.2, 1.2] },
+                xf,
+                m,
+            );
         }
     }
 
@@ -139,7 +192,8 @@ impl Gen<'_> {
         let c = &self.cfg.camera;
         let yaw = (self.unit() - 0.5) * 0.2;
         let pitch = -0.05 - 0.1 * self.unit();
-        let forward = DVec3::new(-(yaw.sin() as f64), pitch.sin() as f64, -(yaw.cos() as f64)).normalize();
+        let forward =
+            DVec3::new(-(yaw.sin() as f64), pitch.sin() as f64, -(yaw.cos() as f64)).normalize();
         let up = (DVec3::Y - forward * forward.y).normalize();
         LightFieldCamera {
             resolution: c.resolution,
@@ -148,20 +202,29 @@ impl Gen<'_> {
             sensor_size_mm: c.sensor_size_mm,
             baseline_m: c.baseline_mm / 1000.0,
             focus_distance_m: c.focus_distance_m,
-            position: DVec3::new(0.0, 1.2 + 0.4 * self.unit() as f64, size.z as f64 / 2.0 - 0.2),
+            position: DVec3::new(
+                0.0,
+                1.2 + 0.4 * self.unit() as f64,
+                size.z as f64 / 2.0 - 0.2,
+            ),
             forward,
             up,
         }
     }
 
-    /// One random piece of furniture standing on the floor in front of the camera.
-    fn furniture(&mut self, room: Vec3, max_z: f32) {
-        let x = (self.unit() - 0.5) * (room.x - 0.8);
-        let z = -room.z / 2.0 + 0.4 + self.unit() * (max_z + room.z / 2.0 - 0.4);
-        let at = Vec3::new(x, 0.0, z);
+    /// One random piece of furniture standing on the floor inside the camera's view.
+    ///
+    /// The HCI lens sees only ~20° across, so objects are spread over the frustum's width at
+    /// their distance (plus a margin for partial occluders at the image border), from 2.5 m
+    /// in front of the camera to the back wall.
+    fn furniture(&mut self, room: Vec3, cam: &LightFieldCamera) {
+        let half_fov = (cam.sensor_size_mm / 2.0 / cam.focal_length_mm) as f32;
+        let cam_z = cam.position.z as f32;
+        let dist = 2.5 + self.unit() * (cam_z + room.z / 2.0 - 3.0);
+        let half_width = (half_fov * dist + 0.3).min(room.x / 2.0 - 0.3);
+        let at = Vec3::new((2.0 * self.unit() - 1.0) * half_width, 0.0, cam_z - dist);
         let yaw = self.unit() * TAU;
-        let n = self.objects.len();
-        let name = format!("object_{n}");
+        let name = format!("object_{}", self.objects.len());
         let cutout = self.cfg.scene.cutout;
         match self.rng.random_range(0..6) {
             _ if self.chance(cutout) => self.grid_panel(&name, at, yaw),
@@ -174,21 +237,45 @@ impl Gen<'_> {
     }
 
     fn block(&mut self, name: &str, at: Vec3, yaw: f32) {
-        let size = Vec3::new(0.2 + 0.8 * self.unit(), 0.2 + 1.2 * self.unit(), 0.2 + 0.6 * self.unit());
+        let size = Vec3::new(
+            0.2 + 0.8 * self.unit(),
+            0.2 + 1.2 * self.unit(),
+            0.2 + 0.6 * self.unit(),
+        );
         let m = self.object_material(name);
-        self.add(name, Shape::Cuboid { size }, Transform::at(at + Vec3::Y * size.y / 2.0).rotated_y(yaw), m);
+        self.add(
+            name,
+            Shape::Cuboid { size },
+            Transform::at(at + Vec3::Y * size.y / 2.0).rotated_y(yaw),
+            m,
+        );
     }
 
     fn table(&mut self, name: &str, at: Vec3, yaw: f32) {
-        let (w, d, h) = (0.6 + 0.8 * self.unit(), 0.4 + 0.5 * self.unit(), 0.45 + 0.35 * self.unit());
+        let (w, d, h) = (
+            0.6 + 0.8 * self.unit(),
+            0.4 + 0.5 * self.unit(),
+            0.45 + 0.35 * self.unit(),
+        );
         let top = self.object_material(name);
         let legs = self.object_material(name);
         let rot = Quat::from_rotation_y(yaw);
         let top_xf = Transform::at(at + Vec3::Y * (h - 0.02)).rotated_y(yaw);
-        self.add(name, Shape::Cuboid { size: Vec3::new(w, 0.04, d) }, top_xf, top);
+        self.add(
+            name,
+            Shape::Cuboid {
+                size: Vec3::new(w, 0.04, d),
+            },
+            top_xf,
+            top,
+        );
         for (sx, sz) in [(-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0)] {
             let off = rot * Vec3::new(sx * (w / 2.0 - 0.05), 0.0, sz * (d / 2.0 - 0.05));
-            let leg = Shape::Cylinder { radius: 0.025, height: h - 0.04, segments: 12 };
+            let leg = Shape::Cylinder {
+                radius: 0.025,
+                height: h - 0.04,
+                segments: 12,
+            };
             self.add(&format!("{name}_leg"), leg, Transform::at(at + off), legs);
         }
     }
@@ -197,28 +284,56 @@ impl Gen<'_> {
         let r = 0.1 + 0.3 * self.unit();
         let h = 0.3 * self.unit();
         let m = self.object_material(name);
-        self.add(name, Shape::Sphere { radius: r, rings: 24, segments: 48 }, Transform::at(at + Vec3::Y * (h + r)), m);
+        self.add(
+            name,
+            Shape::Sphere {
+                radius: r,
+                rings: 24,
+                segments: 48,
+            },
+            Transform::at(at + Vec3::Y * (h + r)),
+            m,
+        );
         if h > 0.05 {
             let stand = self.object_material(name);
-            let shape = Shape::Cylinder { radius: r * 0.3, height: h + 0.01, segments: 16 };
+            let shape = Shape::Cylinder {
+                radius: r * 0.3,
+                height: h + 0.01,
+                segments: 16,
+            };
             self.add(&format!("{name}_stand"), shape, Transform::at(at), stand);
         }
     }
 
     fn column(&mut self, name: &str, at: Vec3) {
-        let shape = Shape::Cylinder { radius: 0.05 + 0.2 * self.unit(), height: 0.3 + 1.5 * self.unit(), segments: 32 };
+        let shape = Shape::Cylinder {
+            radius: 0.05 + 0.2 * self.unit(),
+            height: 0.3 + 1.5 * self.unit(),
+            segments: 32,
+        };
         let m = self.object_material(name);
         self.add(name, shape, Transform::at(at), m);
     }
 
     /// A standing pane: semi-transparent sheet, or a thin glass slab.
     fn pane(&mut self, name: &str, at: Vec3, yaw: f32) {
-        let (w, h) = (0.4 + 1.0 * self.unit(), 0.5 + 1.3 * self.unit());
+        let (w, h) = (0.3 + 0.6 * self.unit(), 0.4 + 1.0 * self.unit());
         let centre = at + Vec3::Y * (h / 2.0 + 0.05 * self.unit());
         let xf = Transform::at(centre).rotated_y(yaw * 0.3);
         if self.chance(0.3) {
-            let m = self.material(name, Opacity::constant(1.0), SurfaceModel::Glass { ior: 1.5 });
-            self.add(name, Shape::Cuboid { size: Vec3::new(w, h, 0.01) }, xf, m);
+            let m = self.material(
+                name,
+                Opacity::constant(1.0),
+                SurfaceModel::Glass { ior: 1.5 },
+            );
+            self.add(
+                name,
+                Shape::Cuboid {
+                    size: Vec3::new(w, h, 0.01),
+                },
+                xf,
+                m,
+            );
         } else {
             let a = self.range(self.cfg.scene.opacity_range);
             let m = self.material(name, Opacity::constant(a), SurfaceModel::Standard);
@@ -228,8 +343,12 @@ impl Gen<'_> {
 
     /// A panel with a grid / woven alpha pattern (mesh screens, lattices).
     fn grid_panel(&mut self, name: &str, at: Vec3, yaw: f32) {
-        let (w, h) = (0.5 + 1.0 * self.unit(), 0.6 + 1.2 * self.unit());
-        let opacity = Opacity::Grid { value: 1.0, period: 0.01 + 0.08 * self.unit(), bar: 0.15 + 0.4 * self.unit() };
+        let (w, h) = (0.3 + 0.6 * self.unit(), 0.5 + 1.0 * self.unit());
+        let opacity = Opacity::Grid {
+            value: 1.0,
+            period: 0.01 + 0.08 * self.unit(),
+            bar: 0.15 + 0.4 * self.unit(),
+        };
         let m = self.material(name, opacity, SurfaceModel::Standard);
         let xf = Transform::at(at + Vec3::Y * h / 2.0).rotated_y(yaw * 0.3);
         self.add(name, Shape::Quad { size: [w, h] }, xf, m);

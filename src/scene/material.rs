@@ -32,23 +32,44 @@ pub enum SurfaceModel {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "type", rename_all = "snake_case")]
 pub enum Texture {
-    Constant { color: [f32; 3] },
+    Constant {
+        color: [f32; 3],
+    },
     /// Squares of side `size` metres.
-    Checker { a: [f32; 3], b: [f32; 3], size: f32 },
+    Checker {
+        a: [f32; 3],
+        b: [f32; 3],
+        size: f32,
+    },
     /// Stripes along U of width `width` metres.
-    Stripes { a: [f32; 3], b: [f32; 3], width: f32 },
+    Stripes {
+        a: [f32; 3],
+        b: [f32; 3],
+        width: f32,
+    },
     /// Smooth value noise blending `a` and `b`, feature size `scale` metres.
-    Noise { a: [f32; 3], b: [f32; 3], scale: f32, seed: u32 },
+    Noise {
+        a: [f32; 3],
+        b: [f32; 3],
+        scale: f32,
+        seed: u32,
+    },
 }
 
 /// Opacity: a constant, or an alpha pattern (a grid of bars, a woven mesh).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "type", rename_all = "snake_case")]
 pub enum Opacity {
-    Constant { value: f32 },
+    Constant {
+        value: f32,
+    },
     /// Bars of width `bar·period` every `period` metres in U and V, opacity `value` on the
     /// bars and 0 in the holes.
-    Grid { value: f32, period: f32, bar: f32 },
+    Grid {
+        value: f32,
+        period: f32,
+        bar: f32,
+    },
 }
 
 impl Material {
@@ -67,7 +88,7 @@ impl Texture {
             Texture::Constant { color } => color.into(),
             Texture::Checker { a, b, size } => {
                 let cell = (uv / size).floor();
-                pick(a, b, (cell.x + cell.y).rem_euclid(2.0) as f32)
+                pick(a, b, (cell.x + cell.y).rem_euclid(2.0))
             }
             Texture::Stripes { a, b, width } => pick(a, b, (uv.x / width).floor().rem_euclid(2.0)),
             Texture::Noise { a, b, scale, seed } => pick(a, b, value_noise(uv / scale, seed)),
@@ -126,11 +147,19 @@ mod tests {
 
     #[test]
     fn checker_and_grid_patterns() {
-        let t = Texture::Checker { a: [0.0; 3], b: [1.0; 3], size: 0.5 };
+        let t = Texture::Checker {
+            a: [0.0; 3],
+            b: [1.0; 3],
+            size: 0.5,
+        };
         assert_eq!(t.eval(Vec2::new(0.1, 0.1)).x, 0.0);
         assert_eq!(t.eval(Vec2::new(0.6, 0.1)).x, 1.0);
         assert_eq!(t.eval(Vec2::new(-0.1, 0.1)).x, 1.0);
-        let g = Opacity::Grid { value: 0.9, period: 0.1, bar: 0.2 };
+        let g = Opacity::Grid {
+            value: 0.9,
+            period: 0.1,
+            bar: 0.2,
+        };
         assert_eq!(g.eval(Vec2::new(0.01, 0.05)), 0.9);
         assert_eq!(g.eval(Vec2::new(0.05, 0.05)), 0.0);
         assert_eq!(g.uniform(), None);
@@ -138,7 +167,12 @@ mod tests {
 
     #[test]
     fn noise_is_continuous_and_bounded() {
-        let t = Texture::Noise { a: [0.0; 3], b: [1.0; 3], scale: 1.0, seed: 7 };
+        let t = Texture::Noise {
+            a: [0.0; 3],
+            b: [1.0; 3],
+            scale: 1.0,
+            seed: 7,
+        };
         let mut prev = t.eval(Vec2::new(0.0, 0.3)).x;
         for k in 1..2000 {
             let v = t.eval(Vec2::new(k as f32 * 1e-3, 0.3)).x;

@@ -77,9 +77,17 @@ pub enum Shape {
     /// Rectangle in the local XY plane centred at the origin, normal +Z.
     Quad { size: [f32; 2] },
     /// UV sphere centred at the origin.
-    Sphere { radius: f32, rings: u32, segments: u32 },
+    Sphere {
+        radius: f32,
+        rings: u32,
+        segments: u32,
+    },
     /// Closed cylinder standing on the origin along +Y.
-    Cylinder { radius: f32, height: f32, segments: u32 },
+    Cylinder {
+        radius: f32,
+        height: f32,
+        segments: u32,
+    },
 }
 
 /// Scale, then rotate, then translate.
@@ -92,7 +100,11 @@ pub struct Transform {
 
 impl Transform {
     pub fn at(translation: Vec3) -> Self {
-        Self { translation, rotation: Quat::IDENTITY, scale: Vec3::ONE }
+        Self {
+            translation,
+            rotation: Quat::IDENTITY,
+            scale: Vec3::ONE,
+        }
     }
 
     pub fn rotated_y(mut self, angle: f32) -> Self {

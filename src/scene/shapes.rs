@@ -19,11 +19,20 @@ pub fn tessellate(shape: &Shape, xf: &Transform, out: &mut Vec<MeshTri>) {
         Shape::Cuboid { size } => cuboid(size, Vec3::ZERO, false, out),
         Shape::Room { size } => cuboid(size, Vec3::new(0.0, size.y / 2.0, 0.0), true, out),
         Shape::Quad { size } => quad(
-            [Vec3::new(-0.5, -0.5, 0.0), Vec3::X, Vec3::Y].map(|v| v * Vec3::new(size[0], size[1], 1.0)),
+            [Vec3::new(-0.5, -0.5, 0.0), Vec3::X, Vec3::Y]
+                .map(|v| v * Vec3::new(size[0], size[1], 1.0)),
             out,
         ),
-        Shape::Sphere { radius, rings, segments } => sphere(radius, rings.max(2), segments.max(3), out),
-        Shape::Cylinder { radius, height, segments } => cylinder(radius, height, segments.max(3), out),
+        Shape::Sphere {
+            radius,
+            rings,
+            segments,
+        } => sphere(radius, rings.max(2), segments.max(3), out),
+        Shape::Cylinder {
+            radius,
+            height,
+            segments,
+        } => cylinder(radius, height, segments.max(3), out),
     }
     let m = xf.matrix();
     let nm = Mat3::from_mat4(m).inverse().transpose();
@@ -38,9 +47,18 @@ fn quad([origin, eu, ev]: [Vec3; 3], out: &mut Vec<MeshTri>) {
     let n = eu.cross(ev).normalize();
     let (lu, lv) = (eu.length(), ev.length());
     let c = [origin, origin + eu, origin + eu + ev, origin + ev];
-    let uv = [Vec2::ZERO, Vec2::new(lu, 0.0), Vec2::new(lu, lv), Vec2::new(0.0, lv)];
+    let uv = [
+        Vec2::ZERO,
+        Vec2::new(lu, 0.0),
+        Vec2::new(lu, lv),
+        Vec2::new(0.0, lv),
+    ];
     for [a, b, d] in [[0, 1, 2], [0, 2, 3]] {
-        out.push(MeshTri { p: [c[a], c[b], c[d]], n: [n; 3], uv: [uv[a], uv[b], uv[d]] });
+        out.push(MeshTri {
+            p: [c[a], c[b], c[d]],
+            n: [n; 3],
+            uv: [uv[a], uv[b], uv[d]],
+        });
     }
 }
 
@@ -65,8 +83,15 @@ fn cuboid(size: Vec3, centre: Vec3, inward: bool, out: &mut Vec<MeshTri>) {
 
 fn sphere(radius: f32, rings: u32, segments: u32, out: &mut Vec<MeshTri>) {
     let point = |i: u32, j: u32| {
-        let (theta, phi) = (PI * i as f32 / rings as f32, TAU * j as f32 / segments as f32);
-        let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin());
+        let (theta, phi) = (
+            PI * i as f32 / rings as f32,
+            TAU * j as f32 / segments as f32,
+        );
+        let n = Vec3::new(
+            theta.sin() * phi.cos(),
+            theta.cos(),
+            -theta.sin() * phi.sin(),
+        );
         let uv = Vec2::new(phi * radius, theta * radius);
         (n * radius, n, uv)
     };
@@ -78,7 +103,11 @@ fn cylinder(radius: f32, height: f32, segments: u32, out: &mut Vec<MeshTri>) {
         let phi = TAU * j as f32 / segments as f32;
         let n = Vec3::new(phi.cos(), 0.0, -phi.sin());
         let y = height * i as f32;
-        (n * radius + Vec3::Y * (height - y), n, Vec2::new(phi * radius, height - y))
+        (
+            n * radius + Vec3::Y * (height - y),
+            n,
+            Vec2::new(phi * radius, height - y),
+        )
     };
     grid_mesh(1, segments, side, out);
     for (y, n) in [(0.0, -Vec3::Y), (height, Vec3::Y)] {
@@ -93,7 +122,11 @@ fn cylinder(radius: f32, height: f32, segments: u32, out: &mut Vec<MeshTri>) {
                 std::mem::swap(&mut a, &mut b);
             }
             let uv = [centre, a, b].map(|p| Vec2::new(p.x, p.z));
-            out.push(MeshTri { p: [centre, a, b], n: [n; 3], uv });
+            out.push(MeshTri {
+                p: [centre, a, b],
+                n: [n; 3],
+                uv,
+            });
         }
     }
 }
@@ -112,7 +145,11 @@ fn grid_mesh(
             for [a, b, c] in [[0, 1, 2], [0, 2, 3]] {
                 let p = [v[a].0, v[b].0, v[c].0];
                 if (p[1] - p[0]).cross(p[2] - p[0]).length_squared() > 1e-12 {
-                    out.push(MeshTri { p, n: [v[a].1, v[b].1, v[c].1], uv: [v[a].2, v[b].2, v[c].2] });
+                    out.push(MeshTri {
+                        p,
+                        n: [v[a].1, v[b].1, v[c].1],
+                        uv: [v[a].2, v[b].2, v[c].2],
+                    });
                 }
             }
         }
@@ -132,18 +169,32 @@ mod tests {
     /// Signed volume by the divergence theorem: positive for outward-facing closed meshes.
     fn volume(t: &[MeshTri]) -> f32 {
         let c = Vec3::new(1.0, 2.0, 3.0);
-        t.iter().map(|t| (t.p[0] - c).dot((t.p[1] - c).cross(t.p[2] - c)) / 6.0).sum()
+        t.iter()
+            .map(|t| (t.p[0] - c).dot((t.p[1] - c).cross(t.p[2] - c)) / 6.0)
+            .sum()
     }
 
     #[test]
     fn closed_shapes_have_their_analytic_volume_and_face_outwards() {
-        let v = volume(&tris(Shape::Cuboid { size: Vec3::new(1.0, 2.0, 3.0) }));
+        let v = volume(&tris(Shape::Cuboid {
+            size: Vec3::new(1.0, 2.0, 3.0),
+        }));
         assert!((v - 6.0).abs() < 1e-4, "{v}");
-        let v = volume(&tris(Shape::Room { size: Vec3::new(2.0, 2.0, 2.0) }));
+        let v = volume(&tris(Shape::Room {
+            size: Vec3::new(2.0, 2.0, 2.0),
+        }));
         assert!((v + 8.0).abs() < 1e-4, "room faces inwards: {v}");
-        let v = volume(&tris(Shape::Sphere { radius: 1.0, rings: 64, segments: 128 }));
+        let v = volume(&tris(Shape::Sphere {
+            radius: 1.0,
+            rings: 64,
+            segments: 128,
+        }));
         assert!((v - 4.0 / 3.0 * PI).abs() < 0.01, "{v}");
-        let v = volume(&tris(Shape::Cylinder { radius: 0.5, height: 2.0, segments: 256 }));
+        let v = volume(&tris(Shape::Cylinder {
+            radius: 0.5,
+            height: 2.0,
+            segments: 256,
+        }));
         assert!((v - PI * 0.5).abs() < 0.01, "{v}");
     }
 
@@ -151,8 +202,16 @@ mod tests {
     fn shading_normals_agree_with_winding() {
         for shape in [
             Shape::Cuboid { size: Vec3::ONE },
-            Shape::Sphere { radius: 1.0, rings: 8, segments: 16 },
-            Shape::Cylinder { radius: 1.0, height: 1.0, segments: 16 },
+            Shape::Sphere {
+                radius: 1.0,
+                rings: 8,
+                segments: 16,
+            },
+            Shape::Cylinder {
+                radius: 1.0,
+                height: 1.0,
+                segments: 16,
+            },
             Shape::Quad { size: [1.0, 2.0] },
         ] {
             for t in tris(shape.clone()) {
@@ -165,8 +224,16 @@ mod tests {
     #[test]
     fn quad_uvs_are_metres() {
         let t = tris(Shape::Quad { size: [2.0, 0.5] });
-        let max_u = t.iter().flat_map(|t| t.uv).map(|uv| uv.x).fold(0.0, f32::max);
-        let max_v = t.iter().flat_map(|t| t.uv).map(|uv| uv.y).fold(0.0, f32::max);
+        let max_u = t
+            .iter()
+            .flat_map(|t| t.uv)
+            .map(|uv| uv.x)
+            .fold(0.0, f32::max);
+        let max_v = t
+            .iter()
+            .flat_map(|t| t.uv)
+            .map(|uv| uv.y)
+            .fold(0.0, f32::max);
         assert_eq!((max_u, max_v), (2.0, 0.5));
     }
 }

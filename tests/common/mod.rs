@@ -145,6 +145,7 @@ pub fn settings(spp: u32, max_depth: u32) -> RenderSettings {
         scene_index: 0,
         mode_epsilon: 1e-4,
         shade_all_hits: false,
+        slice_by_surface: true,
     }
 }
 
