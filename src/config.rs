@@ -205,7 +205,7 @@ impl Default for SceneConfig {
             opacity_range: [0.2, 0.8],
             glass: 0.1,
             cutout: 0.15,
-            lights: 3,
+            lights: 4,
             environment: [0.2, 0.22, 0.25],
         }
     }

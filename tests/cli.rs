@@ -124,6 +124,37 @@ fn scene_folder_has_every_hci_and_multimodal_file() {
     assert_eq!(manifest.scenes[0].files.len(), expected.len());
 }
 
+#[test]
+fn gt_for_all_views_writes_per_view_files_consistent_with_the_centre() {
+    let d = tmp();
+    ok(generate(d.path(), "1", &["--set", "render.gt_views=all"]));
+    let scene = d.path().join("train/scene_0000");
+    for v in 0..9 {
+        for f in [
+            "gt_disp_lowres_Cam{v:03}.pfm",
+            "gt_depth_lowres_Cam{v:03}.pfm",
+            "modes_Cam{v:03}.exr",
+        ] {
+            let name = f.replace("{v:03}", &format!("{v:03}"));
+            assert!(scene.join(&name).exists(), "{name} missing");
+        }
+    }
+    for (plain, per_view) in [
+        ("gt_disp_lowres.pfm", "gt_disp_lowres_Cam004.pfm"),
+        ("modes.exr", "modes_Cam004.exr"),
+    ] {
+        assert_eq!(
+            fs::read(scene.join(plain)).unwrap(),
+            fs::read(scene.join(per_view)).unwrap()
+        );
+    }
+    // A corner view sees the scene from elsewhere: its GT differs from the centre's.
+    assert_ne!(
+        fs::read(scene.join("gt_depth_lowres_Cam000.pfm")).unwrap(),
+        fs::read(scene.join("gt_depth_lowres.pfm")).unwrap()
+    );
+}
+
 /// A minimal INI reader written here, independent of lfformat's.
 fn ini(path: &Path) -> BTreeMap<String, String> {
     let mut section = String::new();

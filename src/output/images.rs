@@ -48,6 +48,42 @@ pub fn write_linear_exr(path: &Path, width: usize, height: usize, pixels: &[Vec3
 mod tests {
     use super::*;
 
+    /// A non-symmetric image: red top-left corner, green bottom-right, blue elsewhere.
+    fn corners(w: usize, h: usize) -> Vec<Vec3> {
+        (0..w * h)
+            .map(|i| match (i % w, i / w) {
+                (0, 0) => Vec3::X,
+                (x, y) if x == w - 1 && y == h - 1 => Vec3::Y,
+                _ => Vec3::Z * 0.5,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn png_and_exr_round_trip_with_orientation() {
+        let dir = tempfile::tempdir().unwrap();
+        let (w, h) = (5, 3);
+        let pixels = corners(w, h);
+        let png = dir.path().join("v.png");
+        write_png(&png, w, h, &pixels, 1.0).unwrap();
+        let back = image::open(&png).unwrap().to_rgb8();
+        assert_eq!(back.dimensions(), (5, 3));
+        assert_eq!(back.get_pixel(0, 0).0, [255, 0, 0]);
+        assert_eq!(back.get_pixel(4, 2).0, [0, 255, 0]);
+        assert_eq!(back.get_pixel(1, 0).0, [0, 0, 188]);
+        let exr = dir.path().join("v.exr");
+        write_linear_exr(&exr, w, h, &pixels).unwrap();
+        let img = exr::prelude::read_first_rgba_layer_from_file(
+            &exr,
+            |res, _| vec![Vec3::ZERO; res.width() * res.height()],
+            |buf: &mut Vec<Vec3>, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                buf[pos.y() * 5 + pos.x()] = Vec3::new(r, g, b)
+            },
+        )
+        .unwrap();
+        assert_eq!(img.layer_data.channel_data.pixels, pixels);
+    }
+
     #[test]
     fn srgb_matches_reference_values() {
         assert_eq!(to_srgb8(&[Vec3::new(0.0, 1.0, 0.18)], 1.0), [0, 255, 118]);

@@ -180,7 +180,7 @@ impl Gen<'_> {
             xf.rotation = Quat::from_rotation_x(FRAC_PI_2);
             self.add(
                 &format!("light_{i}"),
-                Shape::Quad { size: [1.2, 1.2] },
+                Shape::Quad { size: [2.4, 1.2] },
                 xf,
                 m,
             );

@@ -56,6 +56,34 @@ impl SliceRange {
     }
 }
 
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slice_index_in_depth_and_disparity_spacing() {
+        let depth = SliceRange {
+            z_near: 1.0,
+            z_far: 5.0,
+            count: 4,
+            spacing: SliceSpacing::Depth,
+        };
+        assert_eq!(
+            [0.5, 1.5, 2.5, 4.99, 9.0].map(|z| depth.index(z)),
+            [0, 0, 1, 3, 3]
+        );
+        // Equal 1/Z: boundaries at 1/Z = 1, 0.8, 0.6, 0.4, 0.2 → Z = 1, 1.25, 1.667, 2.5, 5.
+        let disp = SliceRange {
+            spacing: SliceSpacing::Disparity,
+            ..depth
+        };
+        assert_eq!(
+            [1.1, 1.3, 2.0, 3.0, 4.9].map(|z| disp.index(z)),
+            [0, 1, 2, 3, 3]
+        );
+    }
+}
+
 /// One placed shape.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Object {
