@@ -13,3 +13,4 @@ pub mod pipeline;
 pub mod render;
 pub mod scene;
 pub mod stats;
+pub mod textures;
