@@ -1,0 +1,141 @@
+//! The views a baseline reads and how they are loaded.
+
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+use clap::ValueEnum;
+use lfformat::HciParameters;
+use serde::Serialize;
+
+use crate::dataset::PARAMETERS_FILE;
+
+/// Which views of the grid enter the photo-consistency cost.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum ViewSet {
+    /// The centre row and column (9 + 8 views of 9×9, the thesis' chapter 4 setup).
+    Cross,
+    /// The cross plus both diagonals (EPINET's four stacks).
+    Star,
+    /// Every view.
+    Full,
+}
+
+impl ViewSet {
+    /// Grid positions `(u, v)` of the views in a `nx × ny` grid, centre included.
+    pub fn positions(self, nx: usize, ny: usize) -> Vec<(usize, usize)> {
+        let (uc, vc) = ((nx / 2) as isize, (ny / 2) as isize);
+        let keep = |du: isize, dv: isize| match self {
+            ViewSet::Cross => du == 0 || dv == 0,
+            ViewSet::Star => du == 0 || dv == 0 || du.abs() == dv.abs(),
+            ViewSet::Full => true,
+        };
+        (0..ny)
+            .flat_map(|v| (0..nx).map(move |u| (u, v)))
+            .filter(|&(u, v)| keep(u as isize - uc, v as isize - vc))
+            .collect()
+    }
+}
+
+/// One view: its offset from the centre in grid steps and its RGB pixels in `[0, 1]`.
+pub struct View {
+    /// Columns right of the centre view.
+    pub du: f32,
+    /// Rows below the centre view.
+    pub dv: f32,
+    /// `width * height * 3` values, row-major, top row first.
+    pub rgb: Vec<f32>,
+}
+
+/// The views of a scene that a cost volume needs.
+pub struct LightField {
+    /// Columns.
+    pub width: usize,
+    /// Rows.
+    pub height: usize,
+    /// The selected views, the centre one included.
+    pub views: Vec<View>,
+}
+
+impl LightField {
+    /// Reads `parameters.cfg` and the views of `set` from the scene folder `dir`.
+    pub fn load(dir: &Path, set: ViewSet) -> Result<Self> {
+        Self::load_positions(dir, |nx, ny| set.positions(nx, ny))
+    }
+
+    /// Reads the views at the grid positions `positions(nx, ny)` returns.
+    fn load_positions(
+        dir: &Path,
+        positions: impl FnOnce(usize, usize) -> Vec<(usize, usize)>,
+    ) -> Result<Self> {
+        let params = HciParameters::read(&dir.join(PARAMETERS_FILE))?;
+        let (nx, ny) = (params.num_cams_x as usize, params.num_cams_y as usize);
+        if nx % 2 == 0 || ny % 2 == 0 {
+            bail!(
+                "{}: the camera grid {nx}x{ny} has no centre view",
+                dir.display()
+            );
+        }
+        let (width, height) = (
+            params.image_resolution_x_px as usize,
+            params.image_resolution_y_px as usize,
+        );
+        let views = positions(nx, ny)
+            .into_iter()
+            .map(|(u, v)| {
+                let path = dir.join(format!("input_Cam{:03}.png", v * nx + u));
+                let rgb = read_rgb(&path, width, height)?;
+                Ok(View {
+                    du: u as f32 - (nx / 2) as f32,
+                    dv: v as f32 - (ny / 2) as f32,
+                    rgb,
+                })
+            })
+            .collect::<Result<_>>()?;
+        Ok(Self {
+            width,
+            height,
+            views,
+        })
+    }
+}
+
+/// The centre view of the scene in `dir` as RGB in `[0, 1]`, with its width and height.
+pub fn centre_view(dir: &Path) -> Result<(Vec<f32>, usize, usize)> {
+    let lf = LightField::load_positions(dir, |nx, ny| vec![(nx / 2, ny / 2)])?;
+    let view = lf.views.into_iter().next().expect("one view requested");
+    Ok((view.rgb, lf.width, lf.height))
+}
+
+/// An 8-bit (or 16-bit) image as RGB in `[0, 1]`, checked against the expected size.
+pub fn read_rgb(path: &Path, width: usize, height: usize) -> Result<Vec<f32>> {
+    let img = image::open(path)
+        .with_context(|| format!("{}: cannot read image", path.display()))?
+        .into_rgb32f();
+    if (img.width() as usize, img.height() as usize) != (width, height) {
+        bail!(
+            "{}: {}x{} pixels, parameters.cfg says {width}x{height}",
+            path.display(),
+            img.width(),
+            img.height()
+        );
+    }
+    Ok(img.into_raw())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn view_sets_of_a_9x9_grid() {
+        let cross = ViewSet::Cross.positions(9, 9);
+        assert_eq!(cross.len(), 17);
+        assert!(cross.contains(&(4, 4)) && cross.contains(&(0, 4)) && cross.contains(&(4, 8)));
+        let star = ViewSet::Star.positions(9, 9);
+        assert_eq!(star.len(), 33);
+        assert!(star.contains(&(0, 0)) && star.contains(&(8, 0)) && !star.contains(&(1, 0)));
+        assert_eq!(ViewSet::Full.positions(9, 9).len(), 81);
+        assert_eq!(ViewSet::Cross.positions(3, 1), vec![(0, 0), (1, 0), (2, 0)]);
+    }
+}

@@ -1,0 +1,198 @@
+//! Finding the scene folders of a dataset.
+//!
+//! Three layouts are accepted, so that both lfgen datasets and the HCI benchmark work as
+//! they are: a scene folder itself, a folder of scene folders (`DATASET/val`, HCI's
+//! `training/`), or a folder of split folders (`DATASET` with `train/` and `val/`). A scene
+//! folder is one holding `parameters.cfg`.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+
+/// The file that marks a scene folder.
+pub const PARAMETERS_FILE: &str = "parameters.cfg";
+
+/// One scene of a dataset.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SceneDir {
+    /// The folder name; predictions are looked up by it.
+    pub name: String,
+    /// The split folder it was found in, if any.
+    pub split: Option<String>,
+    /// The scene folder.
+    pub path: PathBuf,
+}
+
+/// The scenes under `root`, sorted by split then name; `splits`, when not empty, keeps only
+/// those split folders (an error if one does not exist).
+pub fn discover(root: &Path, splits: &[String]) -> Result<Vec<SceneDir>> {
+    if !root.is_dir() {
+        bail!("{}: dataset folder does not exist", root.display());
+    }
+    let scenes = if is_scene(root) {
+        reject_splits(root, splits)?;
+        vec![scene_at(root, None)]
+    } else {
+        let direct = scene_children(root, None)?;
+        if direct.is_empty() {
+            from_splits(root, splits)?
+        } else {
+            reject_splits(root, splits)?;
+            direct
+        }
+    };
+    if scenes.is_empty() {
+        bail!(
+            "{}: no scene folders (folders with {PARAMETERS_FILE}) found",
+            root.display()
+        );
+    }
+    check_unique(&scenes)?;
+    Ok(scenes)
+}
+
+/// Scenes of the split folders of `root`.
+fn from_splits(root: &Path, splits: &[String]) -> Result<Vec<SceneDir>> {
+    let mut scenes = Vec::new();
+    for dir in sorted_subdirs(root)? {
+        let split = file_name(&dir);
+        if splits.is_empty() || splits.contains(&split) {
+            scenes.extend(scene_children(&dir, Some(split))?);
+        }
+    }
+    for s in splits {
+        if !root.join(s).is_dir() {
+            bail!("{}: no split folder {s:?}", root.display());
+        }
+    }
+    Ok(scenes)
+}
+
+/// `--split` only makes sense for a folder of split folders.
+fn reject_splits(root: &Path, splits: &[String]) -> Result<()> {
+    if !splits.is_empty() {
+        bail!(
+            "{}: --split given, but this folder holds scenes, not split folders",
+            root.display()
+        );
+    }
+    Ok(())
+}
+
+/// The scene folders directly inside `dir`.
+fn scene_children(dir: &Path, split: Option<String>) -> Result<Vec<SceneDir>> {
+    Ok(sorted_subdirs(dir)?
+        .into_iter()
+        .filter(|d| is_scene(d))
+        .map(|d| scene_at(&d, split.clone()))
+        .collect())
+}
+
+/// Visible sub-folders of `dir`, sorted (hidden ones are partial lfgen output).
+fn sorted_subdirs(dir: &Path) -> Result<Vec<PathBuf>> {
+    let entries =
+        std::fs::read_dir(dir).with_context(|| format!("{}: cannot list", dir.display()))?;
+    let mut dirs: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.is_dir() && !file_name(p).starts_with('.'))
+        .collect();
+    dirs.sort();
+    Ok(dirs)
+}
+
+fn is_scene(dir: &Path) -> bool {
+    dir.join(PARAMETERS_FILE).is_file()
+}
+
+fn scene_at(dir: &Path, split: Option<String>) -> SceneDir {
+    let canonical = dir.canonicalize().unwrap_or_else(|_| dir.to_path_buf());
+    SceneDir {
+        name: file_name(&canonical),
+        split,
+        path: dir.to_path_buf(),
+    }
+}
+
+fn file_name(p: &Path) -> String {
+    p.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+/// Predictions are keyed by scene name, so two scenes may not share one.
+fn check_unique(scenes: &[SceneDir]) -> Result<()> {
+    let mut names: Vec<&str> = scenes.iter().map(|s| s.name.as_str()).collect();
+    names.sort_unstable();
+    if let Some(w) = names.windows(2).find(|w| w[0] == w[1]) {
+        bail!(
+            "two scenes are called {:?}; pick one split with --split",
+            w[0]
+        );
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn make_scene(dir: &Path) {
+        std::fs::create_dir_all(dir).unwrap();
+        std::fs::write(dir.join(PARAMETERS_FILE), "").unwrap();
+    }
+
+    fn names(s: &[SceneDir]) -> Vec<&str> {
+        s.iter().map(|s| s.name.as_str()).collect()
+    }
+
+    #[test]
+    fn all_three_layouts_are_found() {
+        let root = tempfile::tempdir().unwrap();
+        let r = root.path();
+        make_scene(&r.join("train/scene_0001"));
+        make_scene(&r.join("train/scene_0000"));
+        make_scene(&r.join("val/scene_0002"));
+        std::fs::create_dir_all(r.join("train/.scene_0003.partial")).unwrap();
+        let all = discover(r, &[]).unwrap();
+        assert_eq!(names(&all), ["scene_0000", "scene_0001", "scene_0002"]);
+        assert_eq!(all[2].split.as_deref(), Some("val"));
+        let val = discover(r, &["val".into()]).unwrap();
+        assert_eq!(names(&val), ["scene_0002"]);
+        assert_eq!(
+            names(&discover(&r.join("train"), &[]).unwrap()),
+            ["scene_0000", "scene_0001"]
+        );
+        assert_eq!(
+            names(&discover(&r.join("val/scene_0002"), &[]).unwrap()),
+            ["scene_0002"]
+        );
+    }
+
+    #[test]
+    fn problems_are_reported() {
+        let root = tempfile::tempdir().unwrap();
+        let r = root.path();
+        assert!(
+            discover(r, &[])
+                .unwrap_err()
+                .to_string()
+                .contains("no scene folders")
+        );
+        make_scene(&r.join("a/x"));
+        make_scene(&r.join("b/x"));
+        assert!(
+            discover(r, &[])
+                .unwrap_err()
+                .to_string()
+                .contains("two scenes")
+        );
+        assert!(
+            discover(r, &["c".into()])
+                .unwrap_err()
+                .to_string()
+                .contains("\"c\"")
+        );
+        assert!(discover(&r.join("a"), &["a".into()]).is_err());
+        assert!(discover(&r.join("missing"), &[]).is_err());
+    }
+}

@@ -1,0 +1,259 @@
+//! `lfeval`: evaluate light-field depth predictions, or produce baseline / ground-truth
+//! predictions to evaluate. See the crate README for formats and metric definitions.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use clap::{Args, Parser, Subcommand};
+use lfeval::baseline::views::ViewSet;
+use lfeval::baseline::{BaselineConfig, DEFAULT_TEMPERATURE, DEFAULT_WINDOW};
+use lfeval::bins::Bins;
+use lfeval::dataset::{SceneDir, discover};
+use lfeval::metrics::kld::EPSILON;
+use lfeval::pipeline::{self, EvalOptions};
+use lfeval::prediction::Method;
+use lfeval::report::{self, samples::PixelRequest};
+use lfeval::scene_eval::EvalConfig;
+use lfeval::truth::{EtaKind, Reference};
+
+/// Evaluates light-field disparity predictions against lfgen or HCI ground truth.
+///
+/// `lfeval DATASET PRED...` evaluates; `lfeval baseline` and `lfeval truth` write
+/// predictions (a dataset folder literally named `baseline` or `truth` is written `./baseline`).
+#[derive(Parser)]
+#[command(
+    name = "lfeval",
+    version,
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    #[command(flatten)]
+    eval: EvalArgs,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run the classical cost-volume baseline and write its predictions.
+    Baseline(BaselineArgs),
+    /// Write the ground truth as a method's predictions (checks a pipeline: scores 0).
+    Truth(TruthArgs),
+}
+
+/// Options every command shares.
+#[derive(Args)]
+struct Common {
+    /// Only these split folders of DATASET (repeatable), e.g. --split val.
+    #[arg(long = "split", value_name = "NAME")]
+    splits: Vec<String>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// No progress bar.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+/// The disparity bins.
+#[derive(Args)]
+struct BinArgs {
+    /// Number of disparity bins.
+    #[arg(long, default_value_t = Bins::THESIS.count)]
+    bins: usize,
+    /// Disparity range MIN,MAX of the bins, pixels.
+    #[arg(long, value_name = "MIN,MAX", default_value = "-3.5,3.5", allow_hyphen_values = true,
+          value_parser = parse_range)]
+    range: (f64, f64),
+}
+
+impl BinArgs {
+    fn bins(&self) -> Result<Bins> {
+        Bins::new(self.range.0, self.range.1, self.bins).map_err(anyhow::Error::msg)
+    }
+}
+
+#[derive(Args)]
+struct EvalArgs {
+    /// Dataset root, split folder or scene folder.
+    #[arg(required = true)]
+    dataset: Option<PathBuf>,
+    /// Prediction folders, one per method (named by the folder).
+    #[arg(required = true)]
+    predictions: Vec<PathBuf>,
+    /// Report folder.
+    #[arg(long, default_value = "lfeval_report")]
+    out: PathBuf,
+    #[command(flatten)]
+    common: Common,
+    #[command(flatten)]
+    bins: BinArgs,
+    /// Added to every KLD bin of both distributions before renormalising.
+    #[arg(long, default_value_t = EPSILON)]
+    epsilon: f64,
+    /// Pixels left out at each image side.
+    #[arg(long, default_value_t = 15)]
+    border: usize,
+    /// Ground truth of the summary table, sparsification and error maps.
+    #[arg(long, value_enum, default_value = "front")]
+    reference: Reference,
+    /// Which η is a mode's probability.
+    #[arg(long, value_enum, default_value = "over")]
+    eta: EtaKind,
+    /// Samples of the sparsification curves.
+    #[arg(long, default_value_t = 100)]
+    sparsification_steps: usize,
+    /// Plot posteriors at SCENE:X,Y (repeatable).
+    #[arg(long = "pixel", value_name = "SCENE:X,Y")]
+    pixels: Vec<PixelRequest>,
+    /// Scenes (the first N) that get automatically chosen posterior plots.
+    #[arg(long, default_value_t = 2)]
+    plot_scenes: usize,
+    /// Skip the per-scene BadPix maps.
+    #[arg(long)]
+    no_error_maps: bool,
+}
+
+#[derive(Args)]
+struct BaselineArgs {
+    /// Dataset root, split folder or scene folder.
+    dataset: PathBuf,
+    /// Prediction folder to write.
+    #[arg(long)]
+    out: PathBuf,
+    #[command(flatten)]
+    common: Common,
+    #[command(flatten)]
+    bins: BinArgs,
+    /// Views entering the photo-consistency cost.
+    #[arg(long, value_enum, default_value = "cross")]
+    views: ViewSet,
+    /// Softmax temperature, in units of the cost (colour variance, colours in [0, 1]).
+    #[arg(long, default_value_t = DEFAULT_TEMPERATURE)]
+    temperature: f64,
+    /// Radius of the cost aggregation window (0: none).
+    #[arg(long, default_value_t = DEFAULT_WINDOW)]
+    window: usize,
+    /// Do not write posteriors (they hold bins × pixels floats per scene).
+    #[arg(long)]
+    no_posterior: bool,
+}
+
+#[derive(Args)]
+struct TruthArgs {
+    /// Dataset root, split folder or scene folder.
+    dataset: PathBuf,
+    /// Prediction folder to write.
+    #[arg(long)]
+    out: PathBuf,
+    #[command(flatten)]
+    common: Common,
+    #[command(flatten)]
+    bins: BinArgs,
+    /// Which mode becomes the disparity map.
+    #[arg(long, value_enum, default_value = "front")]
+    reference: Reference,
+    /// Which η weights the posterior.
+    #[arg(long, value_enum, default_value = "over")]
+    eta: EtaKind,
+}
+
+fn parse_range(s: &str) -> Result<(f64, f64), String> {
+    let bad = || format!("expected MIN,MAX such as -3.5,3.5, got {s:?}");
+    let (a, b) = s.split_once(',').ok_or_else(bad)?;
+    Ok((
+        a.trim().parse().map_err(|_| bad())?,
+        b.trim().parse().map_err(|_| bad())?,
+    ))
+}
+
+fn main() {
+    if let Err(e) = run(Cli::parse()) {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Some(Command::Baseline(a)) => baseline(a),
+        Some(Command::Truth(a)) => truth(a),
+        None => evaluate(cli.eval),
+    }
+}
+
+/// Applies `--threads` and finds the scenes.
+fn setup(dataset: &std::path::Path, common: &Common) -> Result<Vec<SceneDir>> {
+    if let Some(n) = common.threads {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .context("cannot set up the worker threads")?;
+    }
+    discover(dataset, &common.splits)
+}
+
+fn evaluate(a: EvalArgs) -> Result<()> {
+    let dataset = a.dataset.expect("clap requires DATASET");
+    let scenes = setup(&dataset, &a.common)?;
+    let methods = a
+        .predictions
+        .iter()
+        .map(|p| Method::new(p))
+        .collect::<Result<Vec<_>>>()?;
+    if a.sparsification_steps == 0 {
+        anyhow::bail!("--sparsification-steps must be at least 1");
+    }
+    let opts = EvalOptions {
+        config: EvalConfig {
+            bins: a.bins.bins()?,
+            epsilon: a.epsilon,
+            border: a.border,
+            eta: a.eta,
+            reference: a.reference,
+            sparsification_steps: a.sparsification_steps,
+        },
+        out: a.out.clone(),
+        pixels: a.pixels,
+        auto_plot_scenes: a.plot_scenes,
+        error_maps: !a.no_error_maps,
+        quiet: a.common.quiet,
+    };
+    std::fs::create_dir_all(&a.out)
+        .with_context(|| format!("{}: cannot create", a.out.display()))?;
+    let eval = pipeline::evaluate_dataset(&dataset, scenes, methods, &opts)?;
+    report::write_all(&eval, &a.out)?;
+    if !a.common.quiet {
+        print!("{}", report::table::main_table(&eval).to_markdown());
+        eprintln!("report written to {}", a.out.join("report.html").display());
+    }
+    Ok(())
+}
+
+fn baseline(a: BaselineArgs) -> Result<()> {
+    let scenes = setup(&a.dataset, &a.common)?;
+    if !(a.temperature.is_finite() && a.temperature > 0.0) {
+        anyhow::bail!("--temperature must be positive, got {}", a.temperature);
+    }
+    let cfg = BaselineConfig {
+        bins: a.bins.bins()?,
+        views: a.views,
+        temperature: a.temperature,
+        window: a.window,
+    };
+    pipeline::baseline_dataset(
+        &a.dataset,
+        &scenes,
+        &a.out,
+        &cfg,
+        !a.no_posterior,
+        a.common.quiet,
+    )
+}
+
+fn truth(a: TruthArgs) -> Result<()> {
+    let scenes = setup(&a.dataset, &a.common)?;
+    let settings = (a.reference, a.eta, a.bins.bins()?);
+    pipeline::truth_dataset(&a.dataset, &scenes, &a.out, settings, a.common.quiet)
+}

@@ -1,0 +1,216 @@
+//! End to end: write a tiny dataset with the lfformat writers, run `lfeval baseline` and
+//! `lfeval truth`, evaluate both, and check the report files and the numbers.
+//!
+//! The scenes are fronto-parallel planes with a random texture at an integer disparity, so
+//! every view is an exact integer shift of the centre view and the baseline must find the
+//! right bin almost everywhere. A block of pixels gets a second ground-truth mode so the
+//! multimodal KLD has pixels to average over.
+
+use std::path::Path;
+use std::process::Command;
+
+use lfformat::pfm::{FloatImage, write_pfm};
+use lfformat::{HciParameters, Mode, ModeMap, modes::write_modes_exr};
+use serde_json::Value;
+
+const SIZE: usize = 48;
+const GRID: usize = 9;
+const BORDER: &str = "6";
+
+/// A deterministic texture value in [0, 1] per integer position and channel.
+fn texture(x: i64, y: i64, c: u64) -> u8 {
+    let mut h = (x as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        ^ (y as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F)
+        ^ c.wrapping_mul(0x1656_67B1_9E37_79F9);
+    h ^= h >> 29;
+    h = h.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    (h >> 56) as u8
+}
+
+fn parameters(name: &str) -> HciParameters {
+    HciParameters {
+        focal_length_mm: 100.0,
+        image_resolution_x_px: SIZE as u32,
+        image_resolution_y_px: SIZE as u32,
+        sensor_size_mm: 35.0,
+        fstop: 100.0,
+        num_cams_x: GRID as u32,
+        num_cams_y: GRID as u32,
+        baseline_mm: 10.0,
+        focus_distance_m: 2.0,
+        center_cam_x_m: 0.0,
+        center_cam_y_m: 0.0,
+        center_cam_z_m: 0.0,
+        center_cam_rx_rad: 0.0,
+        center_cam_ry_rad: 0.0,
+        center_cam_rz_rad: 0.0,
+        scene: name.into(),
+        category: "test".into(),
+        date: "2024-01-01".into(),
+        version: "test".into(),
+        cycles_seed: 0,
+        disp_min: -3.6,
+        disp_max: 3.6,
+        frustum_disp_min: -3.5,
+        frustum_disp_max: 3.5,
+        depth_map_scale: 1.0,
+    }
+}
+
+/// A plane at integer disparity `d`: a point at `(x, y)` in the centre view is at
+/// `(x - du·d, y - dv·d)` in view `(u, v)`, so view `(u, v)` shows `T(x + du·d, y + dv·d)`.
+fn write_scene(dir: &Path, d: i64) {
+    std::fs::create_dir_all(dir).unwrap();
+    let name = dir.file_name().unwrap().to_str().unwrap();
+    parameters(name).write(&dir.join("parameters.cfg")).unwrap();
+    let c = (GRID / 2) as i64;
+    for v in 0..GRID {
+        for u in 0..GRID {
+            let (du, dv) = (u as i64 - c, v as i64 - c);
+            let img = image::RgbImage::from_fn(SIZE as u32, SIZE as u32, |x, y| {
+                let (tx, ty) = (i64::from(x) + du * d, i64::from(y) + dv * d);
+                image::Rgb([0, 1, 2].map(|ch| texture(tx, ty, ch)))
+            });
+            img.save(dir.join(format!("input_Cam{:03}.png", v * GRID + u)))
+                .unwrap();
+        }
+    }
+    let disp = FloatImage::new(SIZE, SIZE, vec![d as f32; SIZE * SIZE]);
+    write_pfm(&dir.join("gt_disp_lowres.pfm"), &disp).unwrap();
+    let mode = |disparity: f32, eta: f32| Mode {
+        disparity,
+        depth: 2.0,
+        eta,
+        eta_exact: eta,
+    };
+    let mut modes = ModeMap::new(SIZE, SIZE);
+    for y in 0..SIZE {
+        for x in 0..SIZE {
+            if (20..28).contains(&x) && (20..28).contains(&y) {
+                modes.push_pixel(&[mode(d as f32, 0.6), mode(-2.5, 0.4)]);
+            } else {
+                modes.push_pixel(&[mode(d as f32, 1.0)]);
+            }
+        }
+    }
+    write_modes_exr(&dir.join("modes.exr"), &modes).unwrap();
+}
+
+fn lfeval(args: &[&str]) {
+    let out = Command::new(env!("CARGO_BIN_EXE_lfeval"))
+        .args(args)
+        .output()
+        .expect("lfeval runs");
+    assert!(
+        out.status.success(),
+        "lfeval {args:?} failed:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+fn number(v: &Value, path: &[&str]) -> f64 {
+    let mut cur = v;
+    for key in path {
+        cur = &cur[*key];
+    }
+    cur.as_f64()
+        .unwrap_or_else(|| panic!("{path:?} is not a number: {cur}"))
+}
+
+#[test]
+fn baseline_and_truth_are_evaluated_end_to_end() {
+    let tmp = tempfile::tempdir().unwrap();
+    let root = tmp.path();
+    let ds = root.join("dataset");
+    write_scene(&ds.join("val/scene_0000"), 1);
+    write_scene(&ds.join("val/scene_0001"), -2);
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let (baseline, truth, report) = (
+        root.join("baseline"),
+        root.join("truth"),
+        root.join("report"),
+    );
+
+    lfeval(&[
+        "baseline",
+        &s(&ds),
+        "--out",
+        &s(&baseline),
+        "--split",
+        "val",
+        "--quiet",
+    ]);
+    lfeval(&["truth", &s(&ds), "--out", &s(&truth), "--quiet"]);
+    for f in [
+        "disp_maps/scene_0000.pfm",
+        "posteriors/scene_0000.npz",
+        "uncertainty/scene_0001.pfm",
+        "runtimes/scene_0001.txt",
+        "lfeval.json",
+    ] {
+        assert!(baseline.join(f).is_file(), "baseline wrote no {f}");
+    }
+    lfeval(&[
+        &s(&ds),
+        &s(&baseline),
+        &s(&truth),
+        "--out",
+        &s(&report),
+        "--border",
+        BORDER,
+        "--pixel",
+        "scene_0001:24,24",
+        "--quiet",
+    ]);
+
+    for f in [
+        "metrics.json",
+        "report.md",
+        "report.html",
+        "sparsification_badpix007.png",
+        "sparsification_mse.png",
+        "error_maps/baseline/scene_0000.png",
+        "error_maps/truth/scene_0001.png",
+        "posteriors/scene_0001_x24_y24.png",
+    ] {
+        let meta = std::fs::metadata(report.join(f)).unwrap_or_else(|_| panic!("{f} missing"));
+        assert!(meta.len() > 100, "{f} is nearly empty");
+    }
+    let md = std::fs::read_to_string(report.join("report.md")).unwrap();
+    assert!(
+        md.contains("| baseline |") && md.contains("| truth |"),
+        "{md}"
+    );
+
+    let metrics: Value =
+        serde_json::from_slice(&std::fs::read(report.join("metrics.json")).unwrap()).unwrap();
+    let methods = metrics["methods"].as_array().unwrap();
+    let (base, gt) = (&methods[0]["summary"], &methods[1]["summary"]);
+    assert_eq!(methods[0]["name"], "baseline");
+
+    // The ground truth as prediction: zero error, zero KLD, on the Oracle.
+    for key in ["mse_x100", "badpix_001", "badpix_007", "q25"] {
+        assert_eq!(number(gt, &["unimodal", "front", key]), 0.0, "truth {key}");
+    }
+    assert!(number(gt, &["kld", "all"]).abs() < 1e-9);
+    assert!(number(gt, &["sparsification", "badpix_007", "ause"]).abs() < 1e-12);
+    // 8×8 multimodal pixels per scene, inside the 36×36 evaluated frame.
+    assert_eq!(number(gt, &["kld", "pixels_multimodal"]), 128.0);
+    assert_eq!(number(gt, &["kld", "pixels_all"]), 2.0 * 36.0 * 36.0);
+
+    // The baseline on a textured integer-disparity plane: the right bin almost everywhere.
+    let badpix = number(base, &["unimodal", "front", "badpix_007"]);
+    assert!(badpix < 5.0, "baseline BadPix(0.07) = {badpix} %");
+    let mse = number(base, &["unimodal", "front", "mse_x100"]);
+    assert!(mse.is_finite() && mse < 1.0, "baseline MSE×100 = {mse}");
+    for key in ["unimodal", "multimodal", "all"] {
+        let k = number(base, &["kld", key]);
+        assert!(k.is_finite() && k > 0.0, "baseline KLD {key} = {k}");
+    }
+    // Multimodal pixels: the baseline sees only the plane, so it misses the 0.4 mode.
+    assert!(number(base, &["kld", "multimodal"]) > number(base, &["kld", "unimodal"]));
+    let ause = number(base, &["sparsification", "badpix_007", "ause"]);
+    assert!(ause.is_finite() && ause >= 0.0, "AuSE {ause}");
+    let time = number(base, &["runtime_mean_s"]);
+    assert!(time > 0.0 && time < 60.0, "runtime {time}");
+}
