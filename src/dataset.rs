@@ -278,6 +278,6 @@ fn write_readme(out: &Path, m: &Manifest) -> Result<()> {
 }
 
 /// Today's date (UTC) as `YYYY-MM-DD`.
-fn today() -> String {
+pub(crate) fn today() -> String {
     humantime::format_rfc3339(std::time::SystemTime::now()).to_string()[..10].to_string()
 }

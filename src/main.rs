@@ -19,7 +19,7 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Re-render a saved scene.json into a scene folder.
+    /// Render a glTF 2.0 scene, or re-render a saved scene.json, into a scene folder.
     Render(RenderArgs),
     /// Union shard manifests (and verify scenes) into one manifest.json.
     Merge {
@@ -73,11 +73,14 @@ struct GenerateArgs {
 
 #[derive(Args, Debug)]
 struct RenderArgs {
-    /// A scene.json written by lfgen.
+    /// A glTF 2.0 scene (.gltf or .glb), or a scene.json written by lfgen.
     scene: PathBuf,
     /// Output scene folder.
     #[arg(long)]
     out: PathBuf,
+    /// glTF camera (or camera node) name for the centre view (default: gltf.camera).
+    #[arg(long)]
+    camera: Option<String>,
     #[command(flatten)]
     common: ConfigArgs,
 }
@@ -99,7 +102,8 @@ fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Some(Command::Render(a)) => {
             let cfg = load(&a.common)?;
-            lfgen::pipeline::rerender(&cfg, &a.scene, &a.out, a.common.quiet)
+            let camera = a.camera.as_deref();
+            lfgen::pipeline::render_file(&cfg, &a.scene, camera, &a.out, a.common.quiet)
         }
         Some(Command::Merge { dataset }) => {
             let m = dataset::merge(&dataset)?;

@@ -1,14 +1,16 @@
-//! One scene from description to published folder: build, frame, render every view, write.
+//! One scene from description to published folder: build, frame, render every view, write —
+//! for generated scenes, imported glTF scenes and saved `scene.json` files alike.
 
-use crate::config::{Config, GtViews, SliceAssignment};
+use crate::config::{BaselineMode, Config, GtViews, SliceAssignment};
 use crate::output::scene_dir::{GtImages, SceneWriter};
 use crate::render::RenderScene;
 use crate::render::framing::auto_exposure;
 use crate::render::integrator::PathSettings;
 use crate::render::view::{RenderSettings, ViewOutput};
+use crate::scene::assets::Assets;
 use crate::scene::{SceneDesc, builtin};
 use crate::stats::SceneStats;
-use anyhow::Result;
+use anyhow::{Context, Result, bail};
 use lfformat::manifest::FileEntry;
 use std::path::Path;
 use std::sync::atomic::AtomicU64;
@@ -152,27 +154,104 @@ fn scene_stats(
     s
 }
 
+/// `lfgen render FILE --out DIR`: a glTF 2.0 scene (`.gltf`, `.glb`) is imported and
+/// rendered; anything else is read as a saved `scene.json` and rendered again. `camera` (a
+/// glTF camera name) overrides `gltf.camera`.
+pub fn render_file(
+    cfg: &Config,
+    input: &Path,
+    camera: Option<&str>,
+    out: &Path,
+    quiet: bool,
+) -> Result<()> {
+    let ext = input.extension().map(|e| e.to_ascii_lowercase());
+    match ext.as_ref().and_then(|e| e.to_str()) {
+        Some("gltf" | "glb") => {
+            let mut cfg = cfg.clone();
+            if let Some(name) = camera {
+                cfg.gltf.camera = name.to_string();
+            }
+            render_gltf(&cfg, input, out, quiet)
+        }
+        _ if camera.is_some() => bail!(
+            "--camera applies to glTF scenes (.gltf, .glb); {} keeps its saved camera",
+            input.display()
+        ),
+        _ => rerender(cfg, input, out, quiet),
+    }
+}
+
+/// Imports a glTF scene, frames its camera grid (baseline and focus per `cfg.camera`) and
+/// writes it as a scene folder, like a generated scene.
+pub fn render_gltf(cfg: &Config, gltf: &Path, out: &Path, quiet: bool) -> Result<()> {
+    let imported = crate::scene::gltf::import(gltf, cfg)?;
+    for w in &imported.warnings {
+        eprintln!("warning: {}: {w}", gltf.display());
+    }
+    let mut desc = imported.desc;
+    let scene = RenderScene::build_with(&desc, &imported.assets)
+        .with_context(|| gltf.display().to_string())?;
+    desc.slices = scene
+        .frame(
+            &mut desc.camera,
+            &cfg.camera,
+            cfg.render.slices,
+            cfg.render.slice_spacing,
+        )
+        .with_context(|| gltf.display().to_string())?;
+    let (near, far) = (desc.slices.z_near, desc.slices.z_far);
+    if cfg.camera.baseline == BaselineMode::Auto && far < 1.1 * near {
+        eprintln!(
+            "warning: {}: the camera sees depths {near:.3}–{far:.3} m only, so the automatic \
+             baseline is {:.3} m; set camera.baseline=fixed for a physical one",
+            gltf.display(),
+            desc.camera.baseline_m
+        );
+    }
+    let job = RenderJob::from_config(cfg, &render_date(cfg));
+    publish(&mut desc, &scene, &job, out, quiet)
+}
+
 /// `lfgen render SCENE.json --out DIR`: renders a saved scene again, with its saved camera,
 /// slices and exposure, and the render settings of `cfg`.
 pub fn rerender(cfg: &Config, scene_json: &Path, out: &Path, quiet: bool) -> Result<()> {
-    use anyhow::Context;
     let text = std::fs::read_to_string(scene_json)
         .with_context(|| format!("cannot read {}", scene_json.display()))?;
     let mut desc: SceneDesc = serde_json::from_str(&text)
         .with_context(|| format!("{}: not a valid lfgen scene", scene_json.display()))?;
-    let scene = RenderScene::build(&desc).with_context(|| format!("{}", scene_json.display()))?;
-    let date = cfg.dataset.date.clone();
+    let assets = Assets::load(&desc).with_context(|| scene_json.display().to_string())?;
+    let scene = RenderScene::build_with(&desc, &assets)
+        .with_context(|| scene_json.display().to_string())?;
     let job = RenderJob {
         auto_exposure: false,
-        ..RenderJob::from_config(cfg, &date)
+        ..RenderJob::from_config(cfg, &render_date(cfg))
     };
+    publish(&mut desc, &scene, &job, out, quiet)
+}
+
+/// `dataset.date`, or today when it is empty.
+fn render_date(cfg: &Config) -> String {
+    match cfg.dataset.date.is_empty() {
+        true => crate::dataset::today(),
+        false => cfg.dataset.date.clone(),
+    }
+}
+
+/// Renders one scene into the folder `out` (its parent is created) and reports it.
+fn publish(
+    desc: &mut SceneDesc,
+    scene: &RenderScene,
+    job: &RenderJob,
+    out: &Path,
+    quiet: bool,
+) -> Result<()> {
     let root = out
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
     std::fs::create_dir_all(root).with_context(|| format!("cannot create {}", root.display()))?;
     let samples = AtomicU64::new(0);
-    render_scene(&mut desc, &scene, &job, out, root, &samples)?;
+    render_scene(desc, scene, job, out, root, &samples)?;
     if !quiet {
         eprintln!(
             "{}: {} camera rays, written to {}",

@@ -13,7 +13,8 @@ const PROBE_RES: u32 = 96;
 impl RenderScene {
     /// Nearest surface and farthest *visible* surface seen by the centre and corner views
     /// (any hit counts for the near end; the far end is the first fully opaque hit, since
-    /// nothing behind it can contribute to a pixel).
+    /// nothing behind it can contribute to a pixel). The two may coincide — a single
+    /// fronto-parallel wall — since [`Self::frame`] widens the range anyway.
     pub fn probe_depth_range(&self, cam: &LightFieldCamera) -> Option<(f64, f64)> {
         let mut hits = Vec::new();
         let (mut near, mut far) = (f32::INFINITY, 0.0f32);
@@ -44,7 +45,7 @@ impl RenderScene {
                 }
             }
         }
-        (near.is_finite() && far > near).then_some((near as f64, far as f64))
+        (near.is_finite() && far >= near).then_some((near as f64, far as f64))
     }
 
     /// Sets the camera's baseline and focus (auto mode) and returns the slice partition.

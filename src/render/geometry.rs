@@ -52,11 +52,18 @@ pub struct Geometry {
     bvh: CwBvh,
     isect: Vec<IsectTri>,
     pub shading: Vec<TriShading>,
+    /// Opacity per leaf when uniform over the triangle, NaN when it comes from a texture: the
+    /// closest-hit test reads 4 bytes instead of the shading record and the material.
+    leaf_opacity: Vec<f32>,
 }
 
 impl Geometry {
     /// Builds the BVH; rejects non-finite vertices, naming the object.
-    pub fn build(tris: &[SceneTri], object_names: &[String]) -> Result<Self> {
+    pub fn build(
+        tris: &[SceneTri],
+        object_names: &[String],
+        mats: &[RenderMaterial],
+    ) -> Result<Self> {
         if let Some(bad) = tris.iter().find(|t| !t.tri.p.iter().all(|p| p.is_finite())) {
             bail!(
                 "object {:?} has non-finite vertex coordinates",
@@ -87,7 +94,7 @@ impl Geometry {
                 e2: prims[i].v2 - prims[i].v0,
             })
             .collect();
-        let shading = order
+        let shading: Vec<TriShading> = order
             .map(|i| {
                 let t = &tris[i];
                 TriShading {
@@ -99,10 +106,19 @@ impl Geometry {
                 }
             })
             .collect();
+        let leaf_opacity = shading
+            .iter()
+            .map(|s| {
+                mats[s.material as usize]
+                    .uniform_opacity
+                    .unwrap_or(f32::NAN)
+            })
+            .collect();
         Ok(Self {
             bvh,
             isect,
             shading,
+            leaf_opacity,
         })
     }
 
@@ -182,7 +198,12 @@ impl Geometry {
     /// `key` with the triangle, so the same ray sees the same surfaces whichever query asks.
     #[inline]
     pub fn accepts(&self, mats: &[RenderMaterial], hit: &Hit, key: u64) -> bool {
-        let a = self.opacity(mats, hit);
+        let uniform = self.leaf_opacity[hit.tri as usize];
+        let a = if uniform.is_nan() {
+            self.opacity(mats, hit)
+        } else {
+            uniform
+        };
         a >= 1.0
             || (a > 0.0 && unit_float(mix64(key ^ self.shading[hit.tri as usize].id as u64)) < a)
     }

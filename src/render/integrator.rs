@@ -1,5 +1,6 @@
 //! Unidirectional path tracing with next-event estimation, MIS (power heuristic), Russian
-//! roulette and stochastic transparency.
+//! roulette and stochastic transparency. Punctual lights are sampled at every vertex, all of
+//! them, deterministically (no random numbers, so scenes without them draw the same streams).
 
 use super::RenderScene;
 use super::bsdf::{Frame, power_heuristic};
@@ -57,6 +58,9 @@ impl RenderScene {
             let wo_l = frame.to_local(wo);
             if !bsdf.is_delta() && !self.lights.is_empty() {
                 radiance += beta * self.direct_light(p, &h, &frame, wo_l, &bsdf, sampler);
+            }
+            if !bsdf.is_delta() && !self.punctual_lights.is_empty() {
+                radiance += beta * self.punctual_light(p, &h, &frame, wo_l, &bsdf);
             }
             let Some(bs) = bsdf.sample(wo_l, sampler.next_f32(), sampler.next2()) else {
                 break;
@@ -145,6 +149,39 @@ impl RenderScene {
         }
         let light_pdf = ls.pdf_area * dist * dist / cos_light;
         f * ls.emission * (tr * wi_l.z.abs() * power_heuristic(light_pdf, bsdf_pdf) / light_pdf)
+    }
+
+    /// Light from every punctual light, each with a shadow ray through semi-transparent
+    /// surfaces. A delta light has no MIS partner: no BSDF sample can hit it.
+    fn punctual_light(
+        &self,
+        p: Vec3,
+        h: &Hit,
+        frame: &Frame,
+        wo_l: Vec3,
+        bsdf: &super::bsdf::SurfaceParams,
+    ) -> Vec3 {
+        let mut sum = Vec3::ZERO;
+        for light in &self.punctual_lights {
+            let Some(inc) = light.incident(p) else {
+                continue;
+            };
+            let wi_l = frame.to_local(inc.wi);
+            let (f, _) = bsdf.eval(wo_l, wi_l);
+            if f == Vec3::ZERO {
+                continue;
+            }
+            let origin = self.spawn(p, h.tri, inc.wi);
+            let tmax = match inc.dist.is_finite() {
+                true => (p + inc.wi * inc.dist - origin).length() * (1.0 - 1e-3),
+                false => f32::INFINITY,
+            };
+            let tr = self
+                .geometry
+                .transmittance(&self.materials, origin, inc.wi, tmax);
+            sum += f * inc.irradiance * (tr * wi_l.z.abs());
+        }
+        sum
     }
 
     /// Shading normal; opaque surfaces are two-sided, so it is turned towards the viewer.

@@ -1,14 +1,19 @@
-//! Materials as the renderer uses them: the scene's description plus precomputed fast paths.
+//! Materials as the renderer uses them: the scene's description with image textures bound to
+//! their decoded pixels, plus precomputed fast paths.
 
 use super::bsdf::{SurfaceKind, SurfaceParams};
+use crate::scene::assets::Assets;
+use crate::scene::texture_image::{ImageMap, TextureImage};
 use crate::scene::{Material, Opacity, SurfaceModel, Texture};
-use glam::{Vec2, Vec3};
+use anyhow::{Context, Result};
+use glam::{Vec2, Vec3, Vec4};
+use std::sync::Arc;
 
 /// A material resolved for rendering.
 #[derive(Clone, Debug)]
 pub struct RenderMaterial {
-    pub base_color: Texture,
-    pub opacity: Opacity,
+    pub base_color: ColorMap,
+    pub opacity: OpacityMap,
     /// `Some(a)` when opacity is the same everywhere (skips the UV lookup).
     pub uniform_opacity: Option<f32>,
     pub glass_ior: Option<f32>,
@@ -17,12 +22,124 @@ pub struct RenderMaterial {
     pub emission: Vec3,
 }
 
+/// An image with the way a material samples it.
+#[derive(Clone, Debug)]
+pub struct BoundImage {
+    pub pixels: Arc<TextureImage>,
+    pub map: ImageMap,
+}
+
+impl BoundImage {
+    fn bind(map: &ImageMap, assets: &Assets) -> Result<Self> {
+        Ok(Self {
+            pixels: assets.image(map)?,
+            map: map.clone(),
+        })
+    }
+
+    #[inline]
+    fn sample(&self, uv: Vec2) -> Vec4 {
+        self.pixels.sample(&self.map, uv)
+    }
+}
+
+/// Base colour: a scene texture evaluated as it is, or an image times a factor.
+#[derive(Clone, Debug)]
+pub enum ColorMap {
+    Texture(Texture),
+    Image { image: BoundImage, factor: Vec3 },
+}
+
+impl ColorMap {
+    fn bind(t: &Texture, assets: &Assets) -> Result<Self> {
+        Ok(match t {
+            Texture::Image { image, factor } => ColorMap::Image {
+                image: BoundImage::bind(image, assets)?,
+                factor: Vec3::from(*factor),
+            },
+            other => ColorMap::Texture(other.clone()),
+        })
+    }
+
+    #[inline]
+    pub fn eval(&self, uv: Vec2) -> Vec3 {
+        match self {
+            ColorMap::Texture(t) => t.eval(uv),
+            ColorMap::Image { image, factor } => image.sample(uv).truncate() * *factor,
+        }
+    }
+}
+
+/// Opacity: a scene opacity evaluated as it is, or an image's alpha.
+#[derive(Clone, Debug)]
+pub enum OpacityMap {
+    Opacity(Opacity),
+    Image {
+        image: BoundImage,
+        factor: f32,
+        cutoff: Option<f32>,
+    },
+}
+
+impl OpacityMap {
+    fn bind(o: &Opacity, assets: &Assets) -> Result<Self> {
+        Ok(match o {
+            Opacity::Image {
+                image,
+                factor,
+                cutoff,
+            } => OpacityMap::Image {
+                image: BoundImage::bind(image, assets)?,
+                factor: *factor,
+                cutoff: *cutoff,
+            },
+            other => OpacityMap::Opacity(other.clone()),
+        })
+    }
+
+    /// `Some(a)` when the opacity does not depend on the surface position: also for an
+    /// image without transparent texels.
+    fn uniform(&self) -> Option<f32> {
+        match self {
+            OpacityMap::Opacity(o) => o.uniform(),
+            OpacityMap::Image {
+                image,
+                factor,
+                cutoff,
+            } => image
+                .pixels
+                .is_opaque()
+                .then(|| Opacity::from_alpha(1.0, *factor, *cutoff)),
+        }
+    }
+
+    #[inline]
+    pub fn eval(&self, uv: Vec2) -> f32 {
+        match self {
+            OpacityMap::Opacity(o) => o.eval(uv),
+            OpacityMap::Image {
+                image,
+                factor,
+                cutoff,
+            } => Opacity::from_alpha(image.sample(uv).w, *factor, *cutoff),
+        }
+    }
+}
+
 impl RenderMaterial {
-    pub fn new(m: &Material) -> Self {
-        Self {
-            base_color: m.base_color.clone(),
-            opacity: m.opacity.clone(),
-            uniform_opacity: m.opacity.uniform(),
+    /// Resolves `m`, binding its image textures to their pixels in `assets`.
+    pub fn new(m: &Material, assets: &Assets) -> Result<Self> {
+        let bind = || -> Result<(ColorMap, OpacityMap)> {
+            Ok((
+                ColorMap::bind(&m.base_color, assets)?,
+                OpacityMap::bind(&m.opacity, assets)?,
+            ))
+        };
+        let (base_color, opacity) = bind().with_context(|| format!("material {:?}", m.name))?;
+        Ok(Self {
+            uniform_opacity: opacity.uniform(),
+            base_color,
+            opacity,
             glass_ior: match m.model {
                 SurfaceModel::Glass { ior } => Some(ior),
                 SurfaceModel::Standard => None,
@@ -30,7 +147,7 @@ impl RenderMaterial {
             roughness: m.roughness,
             metallic: m.metallic,
             emission: Vec3::from(m.emission),
-        }
+        })
     }
 
     /// The BSDF at a surface point.

@@ -14,35 +14,56 @@ pub mod slices;
 pub mod view;
 
 use crate::scene::SceneDesc;
+use crate::scene::assets::Assets;
 use crate::scene::shapes::tessellate;
-use anyhow::Result;
+use anyhow::{Context, Result, bail, ensure};
 use geometry::{Geometry, SceneTri};
 use glam::Vec3;
-use lights::Lights;
+use lights::{Lights, PunctualLight};
 use material::RenderMaterial;
+
+/// Most triangles a scene may have after instancing (a bound on memory: ~0.4 KB each with
+/// the BVH).
+pub const MAX_TRIANGLES: usize = 20_000_000;
 
 /// A scene ready to trace: triangles in a BVH, resolved materials and lights.
 pub struct RenderScene {
     pub geometry: Geometry,
     pub materials: Vec<RenderMaterial>,
+    /// Emissive triangles.
     pub lights: Lights,
+    pub punctual_lights: Vec<PunctualLight>,
     pub environment: Vec3,
 }
 
 impl RenderScene {
-    /// Tessellates and indexes every object of `desc`.
+    /// Tessellates and indexes every object of a scene that refers to no external data.
     pub fn build(desc: &SceneDesc) -> Result<Self> {
+        Self::build_with(desc, &Assets::default())
+    }
+
+    /// Tessellates and indexes every object of `desc`, taking meshes and images from `assets`.
+    pub fn build_with(desc: &SceneDesc, assets: &Assets) -> Result<Self> {
+        if let Some(bad) = desc.lights.iter().position(|l| !l.is_valid()) {
+            bail!("light {bad} has non-finite or negative values or a degenerate direction");
+        }
         let mut tris = Vec::new();
         let mut mesh = Vec::new();
         for (i, obj) in desc.objects.iter().enumerate() {
-            anyhow::ensure!(
+            ensure!(
                 (obj.material as usize) < desc.materials.len(),
                 "object {:?} refers to missing material {}",
                 obj.name,
                 obj.material
             );
             mesh.clear();
-            tessellate(&obj.shape, &obj.transform, &mut mesh);
+            tessellate(&obj.shape, &obj.transform, assets, &mut mesh)
+                .with_context(|| format!("object {:?}", obj.name))?;
+            ensure!(
+                tris.len() + mesh.len() <= MAX_TRIANGLES,
+                "the scene has more than {MAX_TRIANGLES} triangles (at object {:?})",
+                obj.name
+            );
             tris.extend(mesh.iter().map(|&tri| SceneTri {
                 tri,
                 material: obj.material,
@@ -50,14 +71,18 @@ impl RenderScene {
             }));
         }
         let names: Vec<String> = desc.objects.iter().map(|o| o.name.clone()).collect();
-        let geometry = Geometry::build(&tris, &names)?;
-        let materials: Vec<RenderMaterial> =
-            desc.materials.iter().map(RenderMaterial::new).collect();
+        let materials = desc
+            .materials
+            .iter()
+            .map(|m| RenderMaterial::new(m, assets))
+            .collect::<Result<Vec<_>>>()?;
+        let geometry = Geometry::build(&tris, &names, &materials)?;
         let lights = Lights::new(&geometry, &materials);
         Ok(Self {
             geometry,
             materials,
             lights,
+            punctual_lights: desc.lights.iter().map(PunctualLight::new).collect(),
             environment: Vec3::from(desc.environment),
         })
     }

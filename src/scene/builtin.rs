@@ -52,6 +52,8 @@ pub fn generate(cfg: &Config, index: u64) -> SceneDesc {
         exposure: cfg.render.exposure as f32,
         materials: g.materials,
         objects: g.objects,
+        lights: Vec::new(),
+        sources: Vec::new(),
     }
 }
 

@@ -1,6 +1,8 @@
 //! Materials and the procedural textures they read (evaluated on UVs measured in metres, so a
-//! texture tiles at its real size whatever the object).
+//! texture tiles at its real size whatever the object), or image textures of imported scenes
+//! (evaluated on the mesh's own texture coordinates).
 
+use super::texture_image::ImageMap;
 use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 
@@ -29,6 +31,9 @@ pub enum SurfaceModel {
 }
 
 /// Base-colour textures (linear RGB).
+///
+/// [`Texture::Image`] only names its image; the renderer binds the decoded pixels
+/// (`render::material`), and [`Texture::eval`] on its own returns the factor.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "type", rename_all = "snake_case")]
 pub enum Texture {
@@ -54,9 +59,18 @@ pub enum Texture {
         scale: f32,
         seed: u32,
     },
+    /// An image (sRGB-encoded, decoded to linear) times a linear `factor` (glTF
+    /// `baseColorTexture` × `baseColorFactor`).
+    Image {
+        image: ImageMap,
+        factor: [f32; 3],
+    },
 }
 
-/// Opacity: a constant, or an alpha pattern (a grid of bars, a woven mesh).
+/// Opacity: a constant, or an alpha pattern (a grid of bars, a woven mesh), or an image's alpha.
+///
+/// As with [`Texture::Image`], [`Opacity::Image`] is bound to its pixels by the renderer;
+/// [`Opacity::eval`] on its own treats the image's alpha as 1.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "type", rename_all = "snake_case")]
 pub enum Opacity {
@@ -69,6 +83,13 @@ pub enum Opacity {
         value: f32,
         period: f32,
         bar: f32,
+    },
+    /// The image's alpha times `factor` (glTF `BLEND`); with a `cutoff` (glTF `MASK`) the
+    /// surface is opaque where that product is at least the cutoff and absent elsewhere.
+    Image {
+        image: ImageMap,
+        factor: f32,
+        cutoff: Option<f32>,
     },
 }
 
@@ -92,6 +113,7 @@ impl Texture {
             }
             Texture::Stripes { a, b, width } => pick(a, b, (uv.x / width).floor().rem_euclid(2.0)),
             Texture::Noise { a, b, scale, seed } => pick(a, b, value_noise(uv / scale, seed)),
+            Texture::Image { factor, .. } => factor.into(),
         }
     }
 }
@@ -105,7 +127,18 @@ impl Opacity {
     pub fn uniform(&self) -> Option<f32> {
         match *self {
             Opacity::Constant { value } => Some(value),
-            Opacity::Grid { .. } => None,
+            Opacity::Grid { .. } | Opacity::Image { .. } => None,
+        }
+    }
+
+    /// Opacity from an image's `alpha` (the alpha test of glTF `MASK` when there is a cutoff).
+    #[inline]
+    pub fn from_alpha(alpha: f32, factor: f32, cutoff: Option<f32>) -> f32 {
+        let a = alpha * factor;
+        match cutoff {
+            Some(c) if a >= c => 1.0,
+            Some(_) => 0.0,
+            None => a,
         }
     }
 
@@ -116,6 +149,7 @@ impl Opacity {
                 let f = (uv / period).fract_gl();
                 if f.x < bar || f.y < bar { value } else { 0.0 }
             }
+            Opacity::Image { factor, cutoff, .. } => Self::from_alpha(1.0, factor, cutoff),
         }
     }
 }

@@ -3,14 +3,22 @@
 //! A scene is data, not code: shapes with parameters, transforms, materials and lights, plus the
 //! camera. [`shapes`] turns it into world-space triangles; the renderer never sees this module's
 //! serialisation, and the writers never see the triangles.
+//!
+//! Imported scenes ([`gltf`]) refer to meshes and images of their source file instead of
+//! holding them; [`assets::Assets`] loads what a description refers to.
 
+pub mod assets;
 pub mod builtin;
+pub mod gltf;
+pub mod light;
 pub mod material;
 pub mod shapes;
+pub mod texture_image;
 
 use crate::camera::LightFieldCamera;
 use crate::config::SliceSpacing;
 use glam::{Quat, Vec3};
+pub use light::Light;
 pub use material::{Material, Opacity, SurfaceModel, Texture};
 use serde::{Deserialize, Serialize};
 
@@ -32,6 +40,32 @@ pub struct SceneDesc {
     pub exposure: f32,
     pub materials: Vec<Material>,
     pub objects: Vec<Object>,
+    /// Punctual lights (imported scenes); emissive materials are the area lights.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub lights: Vec<Light>,
+    /// Files that [`Shape::Mesh`] and image textures refer to (imported scenes).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sources: Vec<SourceFile>,
+}
+
+/// A file the scene's meshes and images are read from, with checksums so that a re-render
+/// notices when it changed.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SourceFile {
+    /// Absolute path of the glTF or GLB file.
+    pub path: String,
+    /// SHA-256 of that file (lowercase hex).
+    pub sha256: String,
+    /// External files it references that were read (buffers, images), by their URI.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub resources: Vec<Resource>,
+}
+
+/// An external file referenced by a glTF, by its URI relative to the glTF's folder.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Resource {
+    pub uri: String,
+    pub sha256: String,
 }
 
 /// The depth range `[z_near, z_far]` cut into `count` slices.
@@ -115,6 +149,17 @@ pub enum Shape {
         radius: f32,
         height: f32,
         segments: u32,
+    },
+    /// Triangles of primitive `primitive` of mesh `mesh` in [`SceneDesc::sources`]`[source]`
+    /// (a glTF), placed by `matrix` — the instancing node's world transform, column-major as
+    /// in glTF (it may shear, which a [`Transform`] cannot) — before the object's transform.
+    /// UVs are the primitive's `TEXCOORD_<uv_set>`.
+    Mesh {
+        source: u32,
+        mesh: u32,
+        primitive: u32,
+        uv_set: u32,
+        matrix: [f32; 16],
     },
 }
 

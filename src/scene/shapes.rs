@@ -1,7 +1,10 @@
-//! Tessellation of [`Shape`]s into world-space triangles with normals and metre-scaled UVs.
+//! Tessellation of [`Shape`]s into world-space triangles with normals and metre-scaled UVs
+//! (imported meshes keep their own texture coordinates).
 
+use super::assets::{Assets, MeshKey};
 use super::{Shape, Transform};
-use glam::{Mat3, Vec2, Vec3};
+use anyhow::Result;
+use glam::{Mat3, Mat4, Vec2, Vec3};
 use std::f32::consts::{PI, TAU};
 
 /// One world-space triangle with per-vertex shading normals and UVs (metres).
@@ -12,9 +15,16 @@ pub struct MeshTri {
     pub uv: [Vec2; 3],
 }
 
-/// Appends the triangles of `shape` placed by `xf` to `out`.
-pub fn tessellate(shape: &Shape, xf: &Transform, out: &mut Vec<MeshTri>) {
+/// Appends the triangles of `shape` placed by `xf` to `out`; a [`Shape::Mesh`] takes its
+/// triangles from `assets`.
+pub fn tessellate(
+    shape: &Shape,
+    xf: &Transform,
+    assets: &Assets,
+    out: &mut Vec<MeshTri>,
+) -> Result<()> {
     let start = out.len();
+    let mut m = xf.matrix();
     match *shape {
         Shape::Cuboid { size } => cuboid(size, Vec3::ZERO, false, out),
         Shape::Room { size } => cuboid(size, Vec3::new(0.0, size.y / 2.0, 0.0), true, out),
@@ -33,13 +43,26 @@ pub fn tessellate(shape: &Shape, xf: &Transform, out: &mut Vec<MeshTri>) {
             height,
             segments,
         } => cylinder(radius, height, segments.max(3), out),
+        Shape::Mesh { matrix, .. } => {
+            let key = MeshKey::of(shape).expect("a mesh shape");
+            out.extend_from_slice(assets.mesh(&key)?);
+            m *= Mat4::from_cols_array(&matrix);
+        }
     }
-    let m = xf.matrix();
     let nm = Mat3::from_mat4(m).inverse().transpose();
+    // A mirroring transform reverses the winding; swapping two vertices keeps the winding
+    // normal on the side of the shading normals (emission and light sampling use it).
+    let mirrored = Mat3::from_mat4(m).determinant() < 0.0;
     for t in &mut out[start..] {
         t.p = t.p.map(|p| m.transform_point3(p));
         t.n = t.n.map(|n| (nm * n).normalize_or_zero());
+        if mirrored {
+            t.p.swap(1, 2);
+            t.n.swap(1, 2);
+            t.uv.swap(1, 2);
+        }
     }
+    Ok(())
 }
 
 /// A parallelogram `origin + s·edge_u + t·edge_v`, normal `edge_u × edge_v`, UVs in metres.
@@ -162,7 +185,8 @@ mod tests {
 
     fn tris(shape: Shape) -> Vec<MeshTri> {
         let mut out = Vec::new();
-        tessellate(&shape, &Transform::at(Vec3::new(1.0, 2.0, 3.0)), &mut out);
+        let xf = Transform::at(Vec3::new(1.0, 2.0, 3.0));
+        tessellate(&shape, &xf, &Assets::default(), &mut out).unwrap();
         out
     }
 
@@ -218,6 +242,26 @@ mod tests {
                 let ng = (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]);
                 assert!(ng.dot(t.n[0] + t.n[1] + t.n[2]) > 0.0, "{shape:?}");
             }
+        }
+    }
+
+    #[test]
+    fn a_mirroring_transform_keeps_winding_and_shading_normals_together() {
+        let mirror = Transform {
+            scale: Vec3::new(-1.0, 1.0, 1.0),
+            ..Transform::at(Vec3::ZERO)
+        };
+        let mut out = Vec::new();
+        tessellate(
+            &Shape::Quad { size: [1.0, 1.0] },
+            &mirror,
+            &Assets::default(),
+            &mut out,
+        )
+        .unwrap();
+        for t in out {
+            let ng = (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]);
+            assert!(ng.dot(t.n[0]) > 0.0 && t.n[0] == Vec3::Z, "{t:?}");
         }
     }
 

@@ -80,7 +80,11 @@ impl Draw {
 
     /// A colour around a family's typical hue range.
     fn color(&mut self, hue: (f32, f32), sat: (f32, f32), val: (f32, f32)) -> [f32; 3] {
-        hsv(self.range(hue.0, hue.1), self.range(sat.0, sat.1), self.range(val.0, val.1))
+        hsv(
+            self.range(hue.0, hue.1),
+            self.range(sat.0, sat.1),
+            self.range(val.0, val.1),
+        )
     }
 }
 
@@ -99,7 +103,9 @@ impl TextureSpec {
         let family = FAMILIES[index as usize % FAMILIES.len()];
         let seed = mix64(seed ^ mix64(index as u64 + 1));
         let mut d = Draw(seed);
-        let (hue, sat, val, repeats, size): ((f32, f32), (f32, f32), (f32, f32), (u32, u32), (f32, f32)) = match family {
+        type Range = (f32, f32);
+        let (hue, sat, val, repeats, size): (Range, Range, Range, (u32, u32), Range) = match family
+        {
             Family::Paint => ((0.0, 1.0), (0.05, 0.35), (0.55, 0.9), (1, 1), (1.0, 2.0)),
             Family::Plaster => ((0.05, 0.15), (0.05, 0.25), (0.6, 0.9), (1, 1), (1.0, 2.0)),
             Family::Stripes => ((0.0, 1.0), (0.1, 0.5), (0.4, 0.9), (4, 16), (0.5, 1.0)),
@@ -117,7 +123,14 @@ impl TextureSpec {
         };
         let a = d.color(hue, sat, val);
         let b = d.color(hue, sat, (val.0 * 0.6, val.1 * 0.8));
-        Self { family, seed, a, b, repeats: d.int(repeats.0, repeats.1), tile_size_m: d.range(size.0, size.1) }
+        Self {
+            family,
+            seed,
+            a,
+            b,
+            repeats: d.int(repeats.0, repeats.1),
+            tile_size_m: d.range(size.0, size.1),
+        }
     }
 
     /// Linear RGB at (u, v) ∈ [0, 1)².
@@ -127,7 +140,9 @@ impl TextureSpec {
         let s = self.seed;
         match self.family {
             Family::Paint => a * (0.93 + 0.07 * fbm(u, v, 8, 5, s)),
-            Family::Plaster => a * (0.8 + 0.2 * fbm(u, v, 4, 6, s)) * (0.97 + 0.03 * value(u, v, 128, s + 1)),
+            Family::Plaster => {
+                a * (0.8 + 0.2 * fbm(u, v, 4, 6, s)) * (0.97 + 0.03 * value(u, v, 128, s + 1))
+            }
             Family::Stripes => stripes(u, v, n, a, b, s),
             Family::Motif => motif(u, v, n, a, b, s),
             Family::Tiles => tiles(u, v, n, n, 0.0, a, b, s),
@@ -138,7 +153,9 @@ impl TextureSpec {
             Family::Marble => marble(u, v, n, a, b, s),
             Family::Granite => granite(u, v, a, b, s),
             Family::Concrete => concrete(u, v, a, s),
-            Family::Carpet => a.lerp(b, fbm(u, v, 64, 2, s)) * (0.85 + 0.15 * value(u, v, 256, s + 3)),
+            Family::Carpet => {
+                a.lerp(b, fbm(u, v, 64, 2, s)) * (0.85 + 0.15 * value(u, v, 256, s + 3))
+            }
             Family::Weave => weave(u, v, n, a, b, s),
         }
     }
@@ -146,7 +163,11 @@ impl TextureSpec {
 
 fn stripes(u: f32, _v: f32, n: u32, a: Vec3, b: Vec3, s: u64) -> Vec3 {
     let x = u * n as f32;
-    let c = if (x.floor() as u32).is_multiple_of(2) { a } else { b };
+    let c = if (x.floor() as u32).is_multiple_of(2) {
+        a
+    } else {
+        b
+    };
     let line = (x.fract() < 0.04) as u32 as f32;
     c * (1.0 - 0.3 * line) * (0.96 + 0.04 * fbm(u, 0.0, 8, 3, s))
 }
@@ -160,7 +181,16 @@ fn motif(u: f32, v: f32, n: u32, a: Vec3, b: Vec3, s: u64) -> Vec3 {
 
 /// A running-bond grid of `cols × rows` cells with grout; every other row offset by `offset`.
 #[allow(clippy::too_many_arguments)]
-fn tiles(u: f32, v: f32, cols: u32, rows: u32, offset: f32, cell: Vec3, grout: Vec3, s: u64) -> Vec3 {
+fn tiles(
+    u: f32,
+    v: f32,
+    cols: u32,
+    rows: u32,
+    offset: f32,
+    cell: Vec3,
+    grout: Vec3,
+    s: u64,
+) -> Vec3 {
     let y = v * rows as f32;
     let row = y.floor() as u32;
     let x = u * cols as f32 + if row % 2 == 1 { offset } else { 0.0 };
@@ -211,14 +241,22 @@ fn parquet(u: f32, v: f32, n: u32, a: Vec3, b: Vec3, s: u64) -> Vec3 {
 
 fn marble(u: f32, v: f32, n: u32, a: Vec3, b: Vec3, s: u64) -> Vec3 {
     let turb = 3.0 * fbm(u, v, 4, 6, s);
-    let vein = (std::f32::consts::TAU * (n as f32 * (u + v) + turb)).sin().abs();
+    let vein = (std::f32::consts::TAU * (n as f32 * (u + v) + turb))
+        .sin()
+        .abs();
     a.lerp(b, (1.0 - vein).powi(6))
 }
 
 fn granite(u: f32, v: f32, a: Vec3, b: Vec3, s: u64) -> Vec3 {
     let speck = value(u, v, 192, s);
     let base = a.lerp(b, fbm(u, v, 16, 3, s + 1));
-    if speck > 0.8 { base * 1.4 } else if speck < 0.15 { base * 0.4 } else { base }
+    if speck > 0.8 {
+        base * 1.4
+    } else if speck < 0.15 {
+        base * 0.4
+    } else {
+        base
+    }
 }
 
 fn concrete(u: f32, v: f32, a: Vec3, s: u64) -> Vec3 {

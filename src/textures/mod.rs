@@ -36,7 +36,9 @@ pub struct Catalog {
 /// Renders texture `spec` as linear RGB, `px × px`, sampled at pixel centres.
 pub fn render(spec: &TextureSpec, px: u32) -> Vec<glam::Vec3> {
     let inv = 1.0 / px as f32;
-    (0..px * px).map(|i| spec.eval(((i % px) as f32 + 0.5) * inv, ((i / px) as f32 + 0.5) * inv)).collect()
+    (0..px * px)
+        .map(|i| spec.eval(((i % px) as f32 + 0.5) * inv, ((i / px) as f32 + 0.5) * inv))
+        .collect()
 }
 
 /// Writes `count` textures and the catalogue into `out`.
@@ -46,15 +48,29 @@ pub fn write_library(out: &Path, count: u32, seed: u64) -> Result<Catalog> {
         .into_par_iter()
         .map(|i| {
             let spec = TextureSpec::from_index(seed, i);
-            let file = format!("tex_{i:04}_{}.png", serde_json::to_value(spec.family)?.as_str().unwrap_or("x"));
+            let file = format!(
+                "tex_{i:04}_{}.png",
+                serde_json::to_value(spec.family)?.as_str().unwrap_or("x")
+            );
             let rgb = to_srgb8(&render(&spec, TEXTURE_PX), 1.0);
-            let img = image::RgbImage::from_raw(TEXTURE_PX, TEXTURE_PX, rgb).context("texture size")?;
+            let img =
+                image::RgbImage::from_raw(TEXTURE_PX, TEXTURE_PX, rgb).context("texture size")?;
             let path = out.join(&file);
-            img.save(&path).with_context(|| format!("cannot write {}", path.display()))?;
-            Ok(CatalogEntry { file, spec, licence: "CC0-1.0".into(), author: "lfgen procedural generator".into() })
+            img.save(&path)
+                .with_context(|| format!("cannot write {}", path.display()))?;
+            Ok(CatalogEntry {
+                file,
+                spec,
+                licence: "CC0-1.0".into(),
+                author: "lfgen procedural generator".into(),
+            })
         })
         .collect::<Result<Vec<_>>>()?;
-    let catalog = Catalog { generator: format!("lfgen {}", env!("CARGO_PKG_VERSION")), seed, textures };
+    let catalog = Catalog {
+        generator: format!("lfgen {}", env!("CARGO_PKG_VERSION")),
+        seed,
+        textures,
+    };
     crate::output::scene_dir::write_json(&out.join("catalog.json"), &catalog)?;
     Ok(catalog)
 }
@@ -88,7 +104,11 @@ mod tests {
             let spec = TextureSpec::from_index(0, i);
             let px = 128;
             let (seam, interior) = seam_and_interior(&render(&spec, px), px as usize);
-            assert!(seam <= 1.1 * interior + 1e-4, "{:?} (#{i}): seam {seam} vs interior {interior}", spec.family);
+            assert!(
+                seam <= 1.1 * interior + 1e-4,
+                "{:?} (#{i}): seam {seam} vs interior {interior}",
+                spec.family
+            );
         }
     }
 
@@ -98,7 +118,12 @@ mod tests {
         let spec = TextureSpec::from_index(0, 1);
         let px = 128;
         let half: Vec<glam::Vec3> = (0..px * px)
-            .map(|i| spec.eval(((i % px) as f32 + 0.5) / px as f32 * 0.63, ((i / px) as f32 + 0.5) / px as f32 * 0.63))
+            .map(|i| {
+                spec.eval(
+                    ((i % px) as f32 + 0.5) / px as f32 * 0.63,
+                    ((i / px) as f32 + 0.5) / px as f32 * 0.63,
+                )
+            })
             .collect();
         let (seam, interior) = seam_and_interior(&half, px);
         assert!(seam > 1.1 * interior, "seam {seam} interior {interior}");
@@ -109,12 +134,17 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let cat = write_library(dir.path(), 60, 3).unwrap();
         assert_eq!(cat.textures.len(), 60);
-        let mut hashes: Vec<String> =
-            cat.textures.iter().map(|t| crate::output::hex_sha256(&std::fs::read(dir.path().join(&t.file)).unwrap())).collect();
+        let mut hashes: Vec<String> = cat
+            .textures
+            .iter()
+            .map(|t| crate::output::hex_sha256(&std::fs::read(dir.path().join(&t.file)).unwrap()))
+            .collect();
         hashes.sort();
         hashes.dedup();
         assert_eq!(hashes.len(), 60, "textures must be distinct");
-        let back: Catalog = serde_json::from_slice(&std::fs::read(dir.path().join("catalog.json")).unwrap()).unwrap();
+        let back: Catalog =
+            serde_json::from_slice(&std::fs::read(dir.path().join("catalog.json")).unwrap())
+                .unwrap();
         assert_eq!(back, cat);
     }
 }

@@ -130,6 +130,8 @@ pub fn scene(
         exposure: 1.0,
         materials,
         objects,
+        lights: Vec::new(),
+        sources: Vec::new(),
     }
 }
 

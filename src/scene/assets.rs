@@ -1,0 +1,120 @@
+//! The data a scene description refers to instead of holding: triangles of glTF mesh
+//! primitives (in mesh space) and decoded texture images, loaded once per scene and shared by
+//! every object and material that uses them.
+
+use super::gltf::GltfFile;
+use super::shapes::MeshTri;
+use super::texture_image::{ImageMap, TextureImage};
+use super::{Material, Opacity, SceneDesc, Shape, Texture};
+use anyhow::{Context, Result};
+use std::collections::BTreeMap;
+use std::collections::btree_map::Entry;
+use std::sync::Arc;
+
+/// Identifies the triangles of one mesh primitive with one UV set.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub struct MeshKey {
+    pub source: u32,
+    pub mesh: u32,
+    pub primitive: u32,
+    pub uv_set: u32,
+}
+
+impl MeshKey {
+    /// The key of a [`Shape::Mesh`]; `None` for parametric shapes.
+    pub fn of(shape: &Shape) -> Option<Self> {
+        match *shape {
+            Shape::Mesh {
+                source,
+                mesh,
+                primitive,
+                uv_set,
+                ..
+            } => Some(Self {
+                source,
+                mesh,
+                primitive,
+                uv_set,
+            }),
+            _ => None,
+        }
+    }
+}
+
+/// Loaded meshes and images of a scene (empty for the built-in generator's scenes).
+#[derive(Default)]
+pub struct Assets {
+    meshes: BTreeMap<MeshKey, Vec<MeshTri>>,
+    images: BTreeMap<(u32, u32), Arc<TextureImage>>,
+}
+
+impl Assets {
+    /// Opens every source file of `desc` — refusing one that changed since the scene was
+    /// written — and loads what the scene refers to.
+    pub fn load(desc: &SceneDesc) -> Result<Self> {
+        let files: Vec<GltfFile> = desc
+            .sources
+            .iter()
+            .map(GltfFile::open_unchanged)
+            .collect::<Result<_>>()?;
+        Self::from_files(desc, &files)
+    }
+
+    /// Loads what `desc` refers to from its already opened source files (`files[i]` is source
+    /// `i`).
+    pub fn from_files(desc: &SceneDesc, files: &[GltfFile]) -> Result<Self> {
+        let file = |source: u32| {
+            files
+                .get(source as usize)
+                .with_context(|| format!("the scene refers to missing source file {source}"))
+        };
+        let mut assets = Self::default();
+        for key in desc.objects.iter().filter_map(|o| MeshKey::of(&o.shape)) {
+            if let Entry::Vacant(slot) = assets.meshes.entry(key) {
+                let file = file(key.source)?;
+                slot.insert(file.primitive_triangles(key.mesh, key.primitive, key.uv_set)?);
+            }
+        }
+        for map in desc.materials.iter().flat_map(image_maps) {
+            if let Entry::Vacant(slot) = assets.images.entry((map.source, map.image)) {
+                let image = file(map.source)?.texture_image(map.image)?;
+                slot.insert(Arc::new(image));
+            }
+        }
+        Ok(assets)
+    }
+
+    /// Mesh-space triangles of a mesh primitive.
+    pub fn mesh(&self, key: &MeshKey) -> Result<&[MeshTri]> {
+        self.meshes
+            .get(key)
+            .map(Vec::as_slice)
+            .with_context(|| format!("mesh {key:?} was not loaded"))
+    }
+
+    /// The decoded image a texture refers to.
+    pub fn image(&self, map: &ImageMap) -> Result<Arc<TextureImage>> {
+        self.images
+            .get(&(map.source, map.image))
+            .cloned()
+            .with_context(|| {
+                format!(
+                    "image {} of source {} was not loaded",
+                    map.image, map.source
+                )
+            })
+    }
+}
+
+/// The images a material samples.
+fn image_maps(m: &Material) -> impl Iterator<Item = &ImageMap> {
+    let color = match &m.base_color {
+        Texture::Image { image, .. } => Some(image),
+        _ => None,
+    };
+    let alpha = match &m.opacity {
+        Opacity::Image { image, .. } => Some(image),
+        _ => None,
+    };
+    color.into_iter().chain(alpha)
+}
