@@ -50,12 +50,20 @@ pub struct ViewOutput {
     pub gt: Option<ViewGt>,
 }
 
+/// How far (relative depth) a hit's surface plane, at the pixel centre, may lie from the same
+/// object's hit on the pixel-centre ray and still be snapped to it: planes of one surface meet
+/// there up to the curvature or crease inside one pixel; distinct parts of an object are
+/// farther apart.
+const SNAP_TOLERANCE: f32 = 0.02;
+
 /// Rows per parallel work item: small enough to balance two to many cores.
 const BAND_ROWS: u32 = 2;
 
 /// Per-thread scratch buffers, reused for every pixel of a band.
 struct Scratch {
     hits: Vec<Hit>,
+    /// Every surface on the pixel-centre ray (HCI depth, and slice snapping).
+    centre_hits: Vec<Hit>,
     slice_hits: Vec<SliceHit>,
     acc: SliceAccumulator,
 }
@@ -88,6 +96,7 @@ impl RenderScene {
             .map_init(
                 || Scratch {
                     hits: Vec::new(),
+                    centre_hits: Vec::new(),
                     slice_hits: Vec::new(),
                     acc: SliceAccumulator::new(slices.count as usize),
                 },
@@ -165,6 +174,16 @@ impl PixelCtx<'_> {
         let s = self.settings;
         let mut sampler = Sampler::new(s.seed, s.scene_index, self.view, self.x, self.y, s.spp);
         let mut sum = Vec3::ZERO;
+        let centre = self.rays.ray(self.x as f32 + 0.5, self.y as f32 + 0.5);
+        if with_gt {
+            let geo = &self.scene.geometry;
+            geo.all_hits(
+                centre.origin,
+                centre.dir,
+                f32::INFINITY,
+                &mut scratch.centre_hits,
+            );
+        }
         for i in 0..s.spp {
             let off = sampler.pixel_offset(i);
             let ray = self.rays.ray(self.x as f32 + off.x, self.y as f32 + off.y);
@@ -194,7 +213,8 @@ impl PixelCtx<'_> {
                 &mut band.colors,
             );
             band.mode_counts.push((band.modes.len() - before) as u32);
-            band.hci_depth.push(self.hci_depth(scratch));
+            band.hci_depth
+                .push(self.hci_depth(&scratch.centre_hits, centre.dir));
         }
     }
 
@@ -211,6 +231,7 @@ impl PixelCtx<'_> {
     ) -> Vec3 {
         let centre = self.rays.ray(self.x as f32 + 0.5, self.y as f32 + 0.5);
         let (scene, geo, mats) = (self.scene, &self.scene.geometry, &self.scene.materials);
+        let centre_hits = &scratch.centre_hits;
         geo.all_hits(origin, dir, f32::INFINITY, &mut scratch.hits);
         let first = scratch.hits.iter().position(|h| geo.accepts(mats, h, key));
         let path = &self.settings.path;
@@ -229,7 +250,7 @@ impl PixelCtx<'_> {
                 )),
                 false => None,
             };
-            let slice = self.slice_of(h, centre.origin, centre.dir);
+            let slice = self.slice_of(h, centre.origin, centre.dir, centre_hits);
             scratch.slice_hits.push(SliceHit {
                 slice,
                 z: h.t,
@@ -246,32 +267,41 @@ impl PixelCtx<'_> {
         radiance
     }
 
-    /// Slice of a hit: by its surface's depth on the pixel-centre ray (falling back to the hit
-    /// depth for surfaces seen nearly edge-on), or by the hit depth itself.
-    fn slice_of(&self, h: &Hit, origin: Vec3, centre_dir: Vec3) -> u32 {
-        let surface = || {
-            self.scene
-                .geometry
-                .plane_distance(h.tri, origin, centre_dir)
-        };
-        let z = match self.settings.slice_by_surface {
-            true => surface()
-                .filter(|z| *z > 0.5 * h.t && *z < 2.0 * h.t)
-                .unwrap_or(h.t),
-            false => h.t,
-        };
+    /// Slice of a hit. With surface slicing it is the slice of the hit's *surface* at the pixel
+    /// centre: the depth where the pixel-centre ray meets the hit triangle's plane (the hit's
+    /// own depth for a plane seen nearly edge-on), snapped to the pixel-centre ray's hit on the
+    /// same object when that lies within [`SNAP_TOLERANCE`] of the plane depth or of the hit
+    /// depth — so the faces of one object meeting
+    /// at a crease inside the pixel, and the facets of a tessellated curve, stay one layer.
+    /// Otherwise the hit depth itself decides (literal camera-side clipping).
+    fn slice_of(&self, h: &Hit, origin: Vec3, centre_dir: Vec3, centre_hits: &[Hit]) -> u32 {
+        if !self.settings.slice_by_surface {
+            return self.slices.index(h.t) as u32;
+        }
+        let geo = &self.scene.geometry;
+        let plane = geo.plane_distance(h.tri, origin, centre_dir);
+        let z = plane
+            .filter(|z| *z > 0.5 * h.t && *z < 2.0 * h.t)
+            .unwrap_or(h.t);
+        let object = geo.shading[h.tri as usize].object;
+        let snapped = centre_hits
+            .iter()
+            .filter(|c| geo.shading[c.tri as usize].object == object)
+            .map(|c| c.t)
+            .map(|c| (c, (c - z).abs().min((c - h.t).abs())))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .filter(|(c, gap)| *gap <= SNAP_TOLERANCE * c)
+            .map(|(c, _)| c);
+        let z = snapped.unwrap_or(z);
         self.slices.index(z) as u32
     }
 
     /// HCI semantics: depth of the first surface with coverage ≥ 0.5 on the pixel-centre ray.
-    fn hci_depth(&self, scratch: &mut Scratch) -> f32 {
+    fn hci_depth(&self, centre_hits: &[Hit], dir: Vec3) -> f32 {
         let (geo, mats) = (&self.scene.geometry, &self.scene.materials);
-        let ray = self.rays.ray(self.x as f32 + 0.5, self.y as f32 + 0.5);
-        geo.all_hits(ray.origin, ray.dir, f32::INFINITY, &mut scratch.hits);
-        let first = scratch
-            .hits
+        let first = centre_hits
             .iter()
-            .find(|h| geo.coverage(mats, h, ray.dir) >= 0.5);
+            .find(|h| geo.coverage(mats, h, dir) >= 0.5);
         first.map_or(f32::NAN, |h| h.t)
     }
 }
