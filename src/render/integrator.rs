@@ -49,7 +49,7 @@ impl RenderScene {
                 break;
             };
             let p = origin + dir * h.t;
-            radiance += beta * self.emitted(&h, origin, dir, arrival);
+            radiance += beta * self.emitted(&h, dir, arrival);
             let s = &self.geometry.shading[h.tri as usize];
             let mat = &self.materials[s.material as usize];
             let bsdf = mat.surface(self.geometry.uv(&h));
@@ -95,18 +95,20 @@ impl RenderScene {
 
     /// Emission picked up at a hit, MIS-weighted against light sampling unless the path
     /// arrived by a delta lobe (or from the camera).
-    fn emitted(&self, h: &Hit, origin: Vec3, dir: Vec3, arrival: Arrival) -> Vec3 {
+    fn emitted(&self, h: &Hit, dir: Vec3, arrival: Arrival) -> Vec3 {
         let mat = &self.materials[self.geometry.shading[h.tri as usize].material as usize];
+        if !mat.is_emissive() {
+            return Vec3::ZERO;
+        }
         let ng = self.geometry.geometric_normal(h.tri);
         let dist = dir.length() * h.t;
         let cos_light = -dir.normalize().dot(ng);
-        if !mat.is_emissive() || cos_light <= 0.0 {
+        if cos_light <= 0.0 {
             return Vec3::ZERO;
         }
         if arrival.is_delta {
             return mat.emission;
         }
-        let _ = origin;
         let light_pdf = self.lights.pdf(&self.geometry, h.tri, dist, cos_light);
         mat.emission * power_heuristic(arrival.pdf, light_pdf)
     }
