@@ -180,16 +180,23 @@ pub struct SceneConfig {
     pub room_depth: [f64; 2],
     /// Room height range (metres).
     pub room_height: [f64; 2],
-    /// Number of objects placed in the room.
+    /// Pieces of furniture and accessories drawn per room (rejected when no free spot is found).
     pub objects: u32,
-    /// Probability that an object's material is semi-transparent (opacity in `opacity_range`).
+    /// Probability that a solid material of a piece is semi-transparent (opacity in
+    /// `opacity_range`), when it is neither glass nor a cut-out.
     pub semi_transparent: f64,
     pub opacity_range: [f64; 2],
-    /// Probability of a glass (dielectric) object.
+    /// Probability that a solid material of a piece is glass (smooth dielectric).
     pub glass: f64,
-    /// Probability of a grid / woven cut-out (alpha texture) panel.
+    /// Probability that a solid material becomes a grid / woven alpha cut-out.
     pub cutout: f64,
-    /// Number of ceiling area lights.
+    /// Size of the procedural texture library that room and object textures are drawn from
+    /// (`lfgen textures --count N` writes the same textures to files).
+    pub textures: u32,
+    /// Master seed of that texture library (independent of the dataset seed, so every
+    /// dataset draws from the same library).
+    pub texture_seed: u64,
+    /// Number of ceiling area lights (random colour temperature and luminance each).
     pub lights: u32,
     /// Radiance of the environment seen through openings (linear RGB).
     pub environment: [f64; 3],
@@ -202,10 +209,12 @@ impl Default for SceneConfig {
             room_depth: [7.0, 12.0],
             room_height: [2.6, 3.4],
             objects: 48,
-            semi_transparent: 0.25,
-            opacity_range: [0.2, 0.8],
+            semi_transparent: 0.3,
+            opacity_range: [0.25, 0.75],
             glass: 0.1,
             cutout: 0.15,
+            textures: 750,
+            texture_seed: 0,
             lights: 4,
             environment: [0.2, 0.22, 0.25],
         }
@@ -367,6 +376,9 @@ impl SceneConfig {
             .any(|[a, b]| !(a.is_finite() && *a > 0.0 && a <= b))
         {
             bail!("scene ranges must be positive [min, max] pairs");
+        }
+        if self.textures < 14 {
+            bail!("scene.textures must be at least 14 (one per texture family)");
         }
         let probs = [self.semi_transparent, self.glass, self.cutout];
         if probs.iter().any(|p| !(0.0..=1.0).contains(p)) || self.opacity_range[1] > 1.0 {

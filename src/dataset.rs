@@ -6,6 +6,7 @@
 
 use crate::config::Config;
 use crate::pipeline::{RenderJob, generate_scene, render_scene};
+use crate::stats::{DatasetSummary, SceneStats};
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use lfformat::manifest::{Manifest, SceneEntry, scene_entry_verifies};
@@ -263,7 +264,9 @@ fn write_readme(out: &Path, m: &Manifest) -> Result<()> {
          (`parameters.cfg`, `input_CamNNN.png`, `gt_disp_lowres.pfm`, `gt_depth_lowres.pfm`) plus \
          multimodal ground truth (`modes.exr`, `gt_mpi_lowres.npz`), `scene.json` and `stats.json`.\n\
          `manifest.json` lists every file with its SHA-256. `preview.png`: per scene, the centre \
-         view, the HCI disparity, the number of modes with η > 0.3 and η of the front mode.\n",
+         view, the HCI disparity, the number of modes with η > 0.3 and η of the front mode. \
+         `summary.json`: multimodal shares, mode counts, disparity range, exposure and placement \
+         over all scenes.\n",
         m.generator,
         m.version,
         m.seed,
@@ -274,7 +277,24 @@ fn write_readme(out: &Path, m: &Manifest) -> Result<()> {
     let path = out.join("README.md");
     fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;
     let dirs: Vec<String> = m.scenes.iter().map(|e| e.dir.clone()).collect();
+    write_summary(out, &dirs)?;
     crate::output::preview::write_preview(out, &dirs)
+}
+
+/// `summary.json`: the dataset-wide statistics over every scene's `stats.json`.
+fn write_summary(out: &Path, dirs: &[String]) -> Result<()> {
+    let stats = dirs
+        .iter()
+        .map(|d| {
+            let path = out.join(d).join("stats.json");
+            let text = fs::read_to_string(&path)
+                .with_context(|| format!("cannot read {}", path.display()))?;
+            serde_json::from_str::<SceneStats>(&text)
+                .with_context(|| format!("{}: not valid scene statistics", path.display()))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let summary = DatasetSummary::new(&stats);
+    crate::output::scene_dir::write_json(&out.join("summary.json"), &summary)
 }
 
 /// Today's date (UTC) as `YYYY-MM-DD`.

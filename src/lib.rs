@@ -8,6 +8,7 @@ pub mod bench;
 pub mod camera;
 pub mod config;
 pub mod dataset;
+pub mod export;
 pub mod output;
 pub mod pipeline;
 pub mod render;

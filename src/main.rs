@@ -28,6 +28,25 @@ enum Command {
     },
     /// Measure rays/s and the cost of the 128-slice ground truth on a fixed built-in scene.
     Bench(BenchArgs),
+    /// Write a saved scene (SCENE_DIR/scene.json) for POV-Ray, Blender or Mitsuba 3.
+    Export(ExportArgs),
+    /// Write the procedural seamless texture library as PNGs plus catalog.json.
+    Textures {
+        /// Number of textures.
+        #[arg(long, default_value_t = 750)]
+        count: u32,
+        /// Output folder.
+        #[arg(long, default_value = "textures")]
+        out: PathBuf,
+        /// Library seed (scene.texture_seed: the library the built-in scenes draw from).
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+    },
+    /// Write a contact sheet per scene and an overview page into DATASET/previews/.
+    Preview {
+        /// Dataset folder (with manifest.json).
+        dataset: PathBuf,
+    },
 }
 
 /// Options shared by every command that loads a config.
@@ -86,6 +105,24 @@ struct RenderArgs {
 }
 
 #[derive(Args, Debug)]
+struct ExportArgs {
+    /// Target renderer: pov, blender or mitsuba.
+    #[arg(long)]
+    to: String,
+    /// Scene folder holding scene.json.
+    scene_dir: PathBuf,
+    /// Output folder.
+    #[arg(long)]
+    out: PathBuf,
+    /// Views as off-axis cameras: all, center, or a list such as 0,40,80.
+    #[arg(long, default_value = "all")]
+    views: String,
+    /// The config's render.max_depth sets the renderers' bounce limits.
+    #[command(flatten)]
+    common: ConfigArgs,
+}
+
+#[derive(Args, Debug)]
 struct BenchArgs {
     #[command(flatten)]
     common: ConfigArgs,
@@ -105,6 +142,23 @@ fn run(cli: Cli) -> Result<()> {
             let camera = a.camera.as_deref();
             lfgen::pipeline::render_file(&cfg, &a.scene, camera, &a.out, a.common.quiet)
         }
+        Some(Command::Textures { count, out, seed }) => {
+            let cat = lfgen::textures::write_library(&out, count, seed)?;
+            println!(
+                "{}: {} textures and catalog.json",
+                out.display(),
+                cat.textures.len()
+            );
+            Ok(())
+        }
+        Some(Command::Preview { dataset }) => {
+            let n = lfgen::output::preview::write_contact_sheets(&dataset)?;
+            println!(
+                "{}: {n} contact sheets and index.html",
+                dataset.join("previews").display()
+            );
+            Ok(())
+        }
         Some(Command::Merge { dataset }) => {
             let m = dataset::merge(&dataset)?;
             println!(
@@ -117,6 +171,13 @@ fn run(cli: Cli) -> Result<()> {
         Some(Command::Bench(a)) => {
             let cfg = load(&a.common)?;
             lfgen::bench::run(&cfg)
+        }
+        Some(Command::Export(a)) => {
+            let cfg = load(&a.common)?;
+            let target = lfgen::export::Target::parse(&a.to)?;
+            let views = lfgen::export::extract::ViewSelection::parse(&a.views)?;
+            let depth = cfg.render.max_depth;
+            lfgen::export::export_scene_dir(&a.scene_dir, target, &a.out, &views, depth)
         }
         None => generate(cli.generate),
     }

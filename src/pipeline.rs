@@ -151,6 +151,7 @@ fn scene_stats(
     s.exposure = desc.exposure;
     s.triangles = scene.geometry.triangle_count() as u64;
     s.date = job.date.clone();
+    s.placement = desc.placement.clone();
     s
 }
 
@@ -215,10 +216,7 @@ pub fn render_gltf(cfg: &Config, gltf: &Path, out: &Path, quiet: bool) -> Result
 /// `lfgen render SCENE.json --out DIR`: renders a saved scene again, with its saved camera,
 /// slices and exposure, and the render settings of `cfg`.
 pub fn rerender(cfg: &Config, scene_json: &Path, out: &Path, quiet: bool) -> Result<()> {
-    let text = std::fs::read_to_string(scene_json)
-        .with_context(|| format!("cannot read {}", scene_json.display()))?;
-    let mut desc: SceneDesc = serde_json::from_str(&text)
-        .with_context(|| format!("{}: not a valid lfgen scene", scene_json.display()))?;
+    let mut desc = read_scene_json(scene_json)?;
     let assets = Assets::load(&desc).with_context(|| scene_json.display().to_string())?;
     let scene = RenderScene::build_with(&desc, &assets)
         .with_context(|| scene_json.display().to_string())?;
@@ -227,6 +225,14 @@ pub fn rerender(cfg: &Config, scene_json: &Path, out: &Path, quiet: bool) -> Res
         ..RenderJob::from_config(cfg, &render_date(cfg))
     };
     publish(&mut desc, &scene, &job, out, quiet)
+}
+
+/// Reads a saved `scene.json`, naming the file in errors.
+pub fn read_scene_json(path: &Path) -> Result<SceneDesc> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    serde_json::from_str(&text)
+        .with_context(|| format!("{}: not a valid lfgen scene", path.display()))
 }
 
 /// `dataset.date`, or today when it is empty.

@@ -3,6 +3,7 @@
 //! Nothing here depends on time or threads, so `stats.json` is as reproducible as the images;
 //! render timings go to the dataset's `timings.jsonl` instead.
 
+use crate::scene::placement::PlacementReport;
 use lfformat::ModeMap;
 use serde::{Deserialize, Serialize};
 
@@ -16,6 +17,9 @@ const HIST_BINS: usize = 64;
 pub struct SceneStats {
     /// Fraction of pixels with at least two modes of η > 0.3.
     pub multimodal_fraction: f64,
+    /// Fraction of pixels with at least two modes of any η.
+    #[serde(default)]
+    pub two_mode_fraction: f64,
     /// `mode_count_histogram[k]` = number of pixels with exactly k modes.
     pub mode_count_histogram: Vec<u64>,
     /// Min and max disparity over all modes.
@@ -33,6 +37,9 @@ pub struct SceneStats {
     pub triangles: u64,
     /// Creation date (parameters.cfg `date`).
     pub date: String,
+    /// Pieces placed and rejected by the built-in generator (absent for imported scenes).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub placement: Option<PlacementReport>,
 }
 
 impl SceneStats {
@@ -67,6 +74,7 @@ impl SceneStats {
         });
         Self {
             multimodal_fraction: multimodal as f64 / pixels,
+            two_mode_fraction: counts.iter().skip(2).sum::<u64>() as f64 / pixels,
             mode_count_histogram: counts,
             disparity_range: [lo, hi],
             hci_disparity_range: hci,
@@ -78,6 +86,61 @@ impl SceneStats {
             exposure: 1.0,
             triangles: 0,
             date: String::new(),
+            placement: None,
+        }
+    }
+}
+
+/// Dataset-wide figures over every scene's `stats.json` (`summary.json` at the root).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DatasetSummary {
+    pub scenes: usize,
+    /// [min, median, max] over scenes.
+    pub multimodal_fraction: [f64; 3],
+    pub two_mode_fraction: [f64; 3],
+    pub exposure: [f64; 3],
+    /// Pixels with exactly k modes, summed over scenes.
+    pub mode_count_histogram: Vec<u64>,
+    /// Smallest and largest mode disparity of any scene.
+    pub disparity_range: [f64; 2],
+    pub objects_placed: u64,
+    pub objects_rejected: u64,
+}
+
+impl DatasetSummary {
+    pub fn new(scenes: &[SceneStats]) -> Self {
+        let spread = |f: &dyn Fn(&SceneStats) -> f64| {
+            let mut v: Vec<f64> = scenes.iter().map(f).collect();
+            v.sort_by(f64::total_cmp);
+            match v.len() {
+                0 => [0.0; 3],
+                n => [v[0], (v[(n - 1) / 2] + v[n / 2]) / 2.0, v[n - 1]],
+            }
+        };
+        let mut hist = Vec::<u64>::new();
+        for s in scenes {
+            hist.resize(hist.len().max(s.mode_count_histogram.len()), 0);
+            for (h, c) in hist.iter_mut().zip(&s.mode_count_histogram) {
+                *h += c;
+            }
+        }
+        let placement = scenes.iter().filter_map(|s| s.placement.as_ref());
+        let (placed, rejected) = placement.fold((0, 0), |(p, r), x| {
+            (p + x.placed as u64, r + x.rejected as u64)
+        });
+        Self {
+            scenes: scenes.len(),
+            multimodal_fraction: spread(&|s| s.multimodal_fraction),
+            two_mode_fraction: spread(&|s| s.two_mode_fraction),
+            exposure: spread(&|s| s.exposure as f64),
+            mode_count_histogram: hist,
+            disparity_range: scenes
+                .iter()
+                .fold([f64::INFINITY, f64::NEG_INFINITY], |[a, b], s| {
+                    [a.min(s.disparity_range[0]), b.max(s.disparity_range[1])]
+                }),
+            objects_placed: placed,
+            objects_rejected: rejected,
         }
     }
 }
@@ -100,10 +163,14 @@ mod tests {
         map.push_pixel(&[m(0.0, 1.0)]);
         let s = SceneStats::from_gt(&map, &[0.5, f32::NAN]);
         assert_eq!(s.multimodal_fraction, 0.5);
+        assert_eq!(s.two_mode_fraction, 0.5);
         assert_eq!(s.mode_count_histogram, vec![0, 1, 1]);
         assert_eq!(s.disparity_range, [-1.0, 1.0]);
         assert_eq!(s.hci_disparity_range, [0.5, 0.5]);
         assert!((s.disparity_histogram.iter().sum::<f64>() - 1.0).abs() < 1e-6);
         assert!((s.mean_eta_sum - 1.0).abs() < 1e-6);
+        let summary = DatasetSummary::new(&[s.clone(), s]);
+        assert_eq!(summary.mode_count_histogram, vec![0, 2, 2]);
+        assert_eq!(summary.multimodal_fraction, [0.5; 3]);
     }
 }

@@ -202,10 +202,20 @@ fn parameters_cfg_formula_reproduces_gt_disp_from_gt_depth() {
     // disp_min/max bound the GT, rounded outwards to tenths plus 0.1 as HCI writes them, and
     // lie within the configured range [-3.5, 3.5] widened by that rounding.
     let (lo, hi) = (f("meta.disp_min"), f("meta.disp_max"));
-    let finite = disp.data.iter().filter(|d| d.is_finite()).map(|&d| d as f64);
+    let finite = disp
+        .data
+        .iter()
+        .filter(|d| d.is_finite())
+        .map(|&d| d as f64);
     let (min, max) = finite.fold((f64::MAX, f64::MIN), |(a, b), d| (a.min(d), b.max(d)));
-    assert!(((min * 10.0).floor() / 10.0 - 0.1 - lo).abs() < 1e-9, "{lo} for min {min}");
-    assert!(((max * 10.0).ceil() / 10.0 + 0.1 - hi).abs() < 1e-9, "{hi} for max {max}");
+    assert!(
+        ((min * 10.0).floor() / 10.0 - 0.1 - lo).abs() < 1e-9,
+        "{lo} for min {min}"
+    );
+    assert!(
+        ((max * 10.0).ceil() / 10.0 + 0.1 - hi).abs() < 1e-9,
+        "{hi} for max {max}"
+    );
     assert!(lo >= -3.7 && hi <= 3.7, "{lo} {hi}");
 }
 
@@ -354,4 +364,27 @@ fn bad_input_gives_clear_errors_and_no_scene() {
         "{}",
         stderr(&r)
     );
+}
+
+#[test]
+fn preview_sheets_summary_and_texture_library() {
+    let d = tmp();
+    ok(generate(d.path(), "2", &[]));
+    let summary: serde_json::Value =
+        serde_json::from_slice(&fs::read(d.path().join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["scenes"], 2);
+    assert!(summary["objects_placed"].as_u64().unwrap() > 0);
+    ok(lfgen(&["preview", d.path().to_str().unwrap()], &[]));
+    for name in ["train_scene_0000.png", "train_scene_0001.png", "index.html"] {
+        assert!(d.path().join("previews").join(name).is_file(), "{name}");
+    }
+    let t = tmp();
+    let out = t.path().join("tex");
+    ok(lfgen(
+        &["textures", "--count", "20", "--out", out.to_str().unwrap()],
+        &[],
+    ));
+    let catalog: serde_json::Value =
+        serde_json::from_slice(&fs::read(out.join("catalog.json")).unwrap()).unwrap();
+    assert_eq!(catalog["textures"].as_array().unwrap().len(), 20);
 }

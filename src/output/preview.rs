@@ -1,6 +1,10 @@
 //! `preview.png` at the dataset root: one row per scene — centre view, HCI disparity, number of
 //! modes with η > 0.3, and η of the front-most mode — read back from the written files, so the
 //! sheet shows what users will load.
+//!
+//! `lfgen preview DATASET` adds a contact sheet per scene (`previews/<scene>.png`: centre view,
+//! GT disparity, mode count, η of the second mode, a horizontal and a vertical epipolar-plane
+//! image) and an overview page (`previews/index.html`) with each scene's statistics.
 
 use crate::stats::MULTIMODAL_ETA;
 use anyhow::{Context, Result};
@@ -46,13 +50,18 @@ pub fn write_preview(out: &Path, scene_dirs: &[String]) -> Result<()> {
         .with_context(|| format!("cannot write {}", path.display()))
 }
 
+/// Reads view `index` (`input_CamNNN.png`) of a scene folder.
+fn read_view(dir: &Path, index: u32) -> Result<RgbImage> {
+    let path = dir.join(format!("input_Cam{index:03}.png"));
+    Ok(image::open(&path)
+        .with_context(|| format!("cannot read {}", path.display()))?
+        .to_rgb8())
+}
+
 fn scene_panels(dir: &Path) -> Result<[RgbImage; 4]> {
     let params = lfformat::HciParameters::read(&dir.join("parameters.cfg"))?;
     let center = (params.num_cams_y / 2) * params.num_cams_x + params.num_cams_x / 2;
-    let view_path = dir.join(format!("input_Cam{center:03}.png"));
-    let view = image::open(&view_path)
-        .with_context(|| format!("cannot read {}", view_path.display()))?
-        .to_rgb8();
+    let view = read_view(dir, center)?;
     let disp = read_pfm(&dir.join("gt_disp_lowres.pfm"))?;
     let modes = read_modes_exr(&dir.join("modes.exr"))?;
     let (w, h) = view.dimensions();
@@ -77,6 +86,109 @@ fn scene_panels(dir: &Path) -> Result<[RgbImage; 4]> {
         )
     });
     Ok([view, disparity, count, front])
+}
+
+/// Rows of an epipolar-plane image are this many pixels tall per view.
+const EPI_ROW: u32 = 4;
+
+/// Writes `previews/<scene>.png` for every scene of the dataset's manifest and
+/// `previews/index.html`; returns the number of sheets.
+pub fn write_contact_sheets(dataset: &Path) -> Result<usize> {
+    let manifest = lfformat::manifest::Manifest::read(&dataset.join("manifest.json"))?;
+    let out = dataset.join("previews");
+    std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;
+    let mut rows = String::new();
+    for e in &manifest.scenes {
+        let dir = dataset.join(&e.dir);
+        let sheet = contact_sheet(&dir).with_context(|| format!("{}", dir.display()))?;
+        let name = format!("{}.png", e.dir.replace('/', "_"));
+        let path = out.join(&name);
+        sheet
+            .save(&path)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        rows.push_str(&overview_row(&dir, &e.dir, &name)?);
+    }
+    let html = format!(
+        "<!doctype html><meta charset=\"utf-8\"><title>lfgen preview</title>\n\
+         <style>body{{font-family:sans-serif}}td{{padding:4px;vertical-align:top}}</style>\n\
+         <h1>{}</h1><p>Per scene: centre view, GT disparity, number of modes, η of the second \
+         mode; below, horizontal and vertical epipolar-plane images.</p>\n<table>{rows}</table>\n",
+        dataset.display()
+    );
+    let index = out.join("index.html");
+    std::fs::write(&index, html).with_context(|| format!("cannot write {}", index.display()))?;
+    Ok(manifest.scenes.len())
+}
+
+/// One table row of the overview: the scene's statistics next to its sheet.
+fn overview_row(dir: &Path, scene: &str, sheet: &str) -> Result<String> {
+    let path = dir.join("stats.json");
+    let text = std::fs::read_to_string(&path)
+        .with_context(|| format!("cannot read {}", path.display()))?;
+    let s: crate::stats::SceneStats = serde_json::from_str(&text)
+        .with_context(|| format!("{}: not valid scene statistics", path.display()))?;
+    let placed = s.placement.map_or(String::new(), |p| {
+        format!("<br>objects placed {} / rejected {}", p.placed, p.rejected)
+    });
+    Ok(format!(
+        "<tr><td><b>{scene}</b><br>multimodal (≥2 modes η>0.3) {:.1} %<br>≥2 modes {:.1} %\
+         <br>disparity {:.2} … {:.2} px<br>exposure {:.2}{placed}</td>\
+         <td><img src=\"{sheet}\"></td></tr>\n",
+        100.0 * s.multimodal_fraction,
+        100.0 * s.two_mode_fraction,
+        s.disparity_range[0],
+        s.disparity_range[1],
+        s.exposure
+    ))
+}
+
+/// The sheet of one scene folder: four panels on top, the two EPIs below.
+fn contact_sheet(dir: &Path) -> Result<RgbImage> {
+    let params = lfformat::HciParameters::read(&dir.join("parameters.cfg"))?;
+    let [view, disparity, _, _] = scene_panels(dir)?;
+    let modes = read_modes_exr(&dir.join("modes.exr"))?;
+    let (w, h) = view.dimensions();
+    let count = RgbImage::from_fn(w, h, |x, y| {
+        colormap(modes.pixel(x as usize, y as usize).len() as f32 / 4.0)
+    });
+    let second = RgbImage::from_fn(w, h, |x, y| {
+        colormap(
+            modes
+                .pixel(x as usize, y as usize)
+                .get(1)
+                .map_or(0.0, |m| m.eta),
+        )
+    });
+    let (nx, ny) = (params.num_cams_x, params.num_cams_y);
+    let horizontal = epi(dir, (0..nx).map(|i| (ny / 2) * nx + i), true)?;
+    let vertical = epi(dir, (0..ny).map(|j| j * nx + nx / 2), false)?;
+    let (ew, eh) = vertical.dimensions();
+    let sheet_h = h + GAP + horizontal.height().max(eh);
+    let mut sheet = RgbImage::from_pixel(4 * w + 3 * GAP, sheet_h, Rgb([255; 3]));
+    for (c, p) in [view, disparity, count, second].iter().enumerate() {
+        image::imageops::replace(&mut sheet, p, (c as u32 * (w + GAP)) as i64, 0);
+    }
+    image::imageops::replace(&mut sheet, &horizontal, 0, (h + GAP) as i64);
+    image::imageops::replace(&mut sheet, &vertical, (w + GAP) as i64, (h + GAP) as i64);
+    debug_assert!(ew <= w);
+    Ok(sheet)
+}
+
+/// An epipolar-plane image through the image centre from `views` (in order): for a row of
+/// cameras the centre row of each view stacked downwards, for a column of cameras the centre
+/// column of each view side by side. Each view takes [`EPI_ROW`] pixels.
+fn epi(dir: &Path, views: impl Iterator<Item = u32>, horizontal: bool) -> Result<RgbImage> {
+    let images: Vec<RgbImage> = views.map(|v| read_view(dir, v)).collect::<Result<_>>()?;
+    let (w, h) = images[0].dimensions();
+    let n = images.len() as u32 * EPI_ROW;
+    Ok(match horizontal {
+        true => RgbImage::from_fn(w, n, |x, y| {
+            *images[(y / EPI_ROW) as usize].get_pixel(x, h / 2)
+        }),
+        false => RgbImage::from_fn(n, h, |x, y| {
+            *images[(x / EPI_ROW) as usize].get_pixel(w / 2, y)
+        }),
+    })
 }
 
 /// A perceptually ordered dark-blue → green → yellow ramp (viridis-like) for t in [0, 1].

@@ -5,6 +5,8 @@ use super::bsdf::{SurfaceKind, SurfaceParams};
 use crate::scene::assets::Assets;
 use crate::scene::texture_image::{ImageMap, TextureImage};
 use crate::scene::{Material, Opacity, SurfaceModel, Texture};
+use crate::textures::TEXTURE_PX;
+use crate::textures::generators::TextureSpec;
 use anyhow::{Context, Result};
 use glam::{Vec2, Vec3, Vec4};
 use std::sync::Arc;
@@ -43,11 +45,53 @@ impl BoundImage {
     }
 }
 
-/// Base colour: a scene texture evaluated as it is, or an image times a factor.
+/// Base colour: a scene texture evaluated as it is, an image times a factor, or a library
+/// texture drawn once into a tile.
 #[derive(Clone, Debug)]
 pub enum ColorMap {
     Texture(Texture),
     Image { image: BoundImage, factor: Vec3 },
+    Tile(Arc<LibraryTile>),
+}
+
+/// A procedural library texture rendered to `TEXTURE_PX`² linear texels (with the tint), so
+/// a hit costs a bilinear lookup instead of the generator's noise octaves.
+#[derive(Debug)]
+pub struct LibraryTile {
+    texels: Vec<Vec3>,
+    px: usize,
+    tile_size_m: f32,
+}
+
+impl LibraryTile {
+    fn new(seed: u64, index: u32, tint: [f32; 3]) -> Self {
+        let spec = TextureSpec::from_index(seed, index);
+        let tint = Vec3::from(tint);
+        let texels = crate::textures::render(&spec, TEXTURE_PX)
+            .into_iter()
+            .map(|c| c * tint)
+            .collect();
+        Self {
+            texels,
+            px: TEXTURE_PX as usize,
+            tile_size_m: spec.tile_size_m,
+        }
+    }
+
+    /// Bilinear lookup with wrap-around (the tile is seamless), UVs in metres.
+    #[inline]
+    fn sample(&self, uv: Vec2) -> Vec3 {
+        let n = self.px;
+        let t = (uv / self.tile_size_m).fract_gl() * n as f32 - Vec2::splat(0.5);
+        let (x0, y0) = (t.x.floor(), t.y.floor());
+        let (fx, fy) = (t.x - x0, t.y - y0);
+        let ix = |x: f32| (x as i64).rem_euclid(n as i64) as usize;
+        let (xa, xb, ya, yb) = (ix(x0), ix(x0 + 1.0), ix(y0), ix(y0 + 1.0));
+        let at = |x: usize, y: usize| self.texels[y * n + x];
+        let top = at(xa, ya).lerp(at(xb, ya), fx);
+        let bottom = at(xa, yb).lerp(at(xb, yb), fx);
+        top.lerp(bottom, fy)
+    }
 }
 
 impl ColorMap {
@@ -57,6 +101,9 @@ impl ColorMap {
                 image: BoundImage::bind(image, assets)?,
                 factor: Vec3::from(*factor),
             },
+            &Texture::Library { seed, index, tint } => {
+                ColorMap::Tile(Arc::new(LibraryTile::new(seed, index, tint)))
+            }
             other => ColorMap::Texture(other.clone()),
         })
     }
@@ -66,6 +113,7 @@ impl ColorMap {
         match self {
             ColorMap::Texture(t) => t.eval(uv),
             ColorMap::Image { image, factor } => image.sample(uv).truncate() * *factor,
+            ColorMap::Tile(tile) => tile.sample(uv),
         }
     }
 }

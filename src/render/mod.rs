@@ -21,6 +21,7 @@ use geometry::{Geometry, SceneTri};
 use glam::Vec3;
 use lights::{Lights, PunctualLight};
 use material::RenderMaterial;
+use rayon::prelude::*;
 
 /// Most triangles a scene may have after instancing (a bound on memory: ~0.4 KB each with
 /// the BVH).
@@ -71,9 +72,10 @@ impl RenderScene {
             }));
         }
         let names: Vec<String> = desc.objects.iter().map(|o| o.name.clone()).collect();
+        // In parallel: library textures are drawn into tiles here.
         let materials = desc
             .materials
-            .iter()
+            .par_iter()
             .map(|m| RenderMaterial::new(m, assets))
             .collect::<Result<Vec<_>>>()?;
         let geometry = Geometry::build(&tris, &names, &materials)?;

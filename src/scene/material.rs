@@ -59,6 +59,15 @@ pub enum Texture {
         scale: f32,
         seed: u32,
     },
+    /// Texture `index` of the procedural library with master `seed`
+    /// ([`crate::textures::TextureSpec::from_index`]), tiling at its real size
+    /// (`tile_size_m` of the spec), times a linear `tint`. The renderer draws it into an image
+    /// once per scene instead of evaluating the generator per hit; `scene.json` stays small.
+    Library {
+        seed: u64,
+        index: u32,
+        tint: [f32; 3],
+    },
     /// An image (sRGB-encoded, decoded to linear) times a linear `factor` (glTF
     /// `baseColorTexture` × `baseColorFactor`).
     Image {
@@ -83,6 +92,12 @@ pub enum Opacity {
         value: f32,
         period: f32,
         bar: f32,
+    },
+    /// Leaf silhouettes: one pointed leaf (a lens between two circular arcs, along V) per
+    /// `period` metres in U and V, opaque inside and absent outside. A quad of one period is
+    /// one leaf; a larger one a spray of leaves.
+    Leaves {
+        period: [f32; 2],
     },
     /// The image's alpha times `factor` (glTF `BLEND`); with a `cutoff` (glTF `MASK`) the
     /// surface is opaque where that product is at least the cutoff and absent elsewhere.
@@ -113,6 +128,11 @@ impl Texture {
             }
             Texture::Stripes { a, b, width } => pick(a, b, (uv.x / width).floor().rem_euclid(2.0)),
             Texture::Noise { a, b, scale, seed } => pick(a, b, value_noise(uv / scale, seed)),
+            Texture::Library { seed, index, tint } => {
+                let spec = crate::textures::generators::TextureSpec::from_index(seed, index);
+                let t = (uv / spec.tile_size_m).fract_gl();
+                spec.eval(t.x, t.y) * Vec3::from(tint)
+            }
             Texture::Image { factor, .. } => factor.into(),
         }
     }
@@ -127,7 +147,7 @@ impl Opacity {
     pub fn uniform(&self) -> Option<f32> {
         match *self {
             Opacity::Constant { value } => Some(value),
-            Opacity::Grid { .. } | Opacity::Image { .. } => None,
+            Opacity::Grid { .. } | Opacity::Leaves { .. } | Opacity::Image { .. } => None,
         }
     }
 
@@ -148,6 +168,12 @@ impl Opacity {
             Opacity::Grid { value, period, bar } => {
                 let f = (uv / period).fract_gl();
                 if f.x < bar || f.y < bar { value } else { 0.0 }
+            }
+            Opacity::Leaves { period } => {
+                let f = (uv / Vec2::from(period)).fract_gl();
+                // Half-width of the leaf at height v: widest in the middle, pointed at both ends.
+                let half = 0.42 * (std::f32::consts::PI * f.y).sin().powf(0.8);
+                if (f.x - 0.5).abs() < half { 1.0 } else { 0.0 }
             }
             Opacity::Image { factor, cutoff, .. } => Self::from_alpha(1.0, factor, cutoff),
         }
@@ -197,6 +223,15 @@ mod tests {
         assert_eq!(g.eval(Vec2::new(0.01, 0.05)), 0.9);
         assert_eq!(g.eval(Vec2::new(0.05, 0.05)), 0.0);
         assert_eq!(g.uniform(), None);
+    }
+
+    #[test]
+    fn leaves_are_opaque_in_the_middle_and_open_at_the_tips_and_sides() {
+        let l = Opacity::Leaves { period: [0.1, 0.2] };
+        assert_eq!(l.eval(Vec2::new(0.05, 0.1)), 1.0);
+        assert_eq!(l.eval(Vec2::new(0.03, 0.001)), 0.0);
+        assert_eq!(l.eval(Vec2::new(0.001, 0.1)), 0.0);
+        assert_eq!(l.eval(Vec2::new(0.15, 0.3)), 1.0, "repeats");
     }
 
     #[test]

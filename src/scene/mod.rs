@@ -9,9 +9,11 @@
 
 pub mod assets;
 pub mod builtin;
+pub mod furniture;
 pub mod gltf;
 pub mod light;
 pub mod material;
+pub mod placement;
 pub mod shapes;
 pub mod texture_image;
 
@@ -43,6 +45,9 @@ pub struct SceneDesc {
     /// Punctual lights (imported scenes); emissive materials are the area lights.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub lights: Vec<Light>,
+    /// How the built-in generator's placement went (absent for imported scenes).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub placement: Option<placement::PlacementReport>,
     /// Files that [`Shape::Mesh`] and image textures refer to (imported scenes).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub sources: Vec<SourceFile>,
@@ -148,6 +153,14 @@ pub enum Shape {
     Cylinder {
         radius: f32,
         height: f32,
+        segments: u32,
+    },
+    /// Surface of revolution about +Y: the polyline `profile` of `[radius, height]` points
+    /// (bottom to top) swept around the axis in `segments` steps. Vases, bottles, glasses,
+    /// lamp shades and pots; a point with radius 0 closes the surface there. Normals face away
+    /// from the axis when the profile runs upwards.
+    Lathe {
+        profile: Vec<[f32; 2]>,
         segments: u32,
     },
     /// Triangles of primitive `primitive` of mesh `mesh` in [`SceneDesc::sources`]`[source]`

@@ -43,6 +43,10 @@ pub fn tessellate(
             height,
             segments,
         } => cylinder(radius, height, segments.max(3), out),
+        Shape::Lathe {
+            ref profile,
+            segments,
+        } => lathe(profile, segments.max(3), out),
         Shape::Mesh { matrix, .. } => {
             let key = MeshKey::of(shape).expect("a mesh shape");
             out.extend_from_slice(assets.mesh(&key)?);
@@ -154,6 +158,47 @@ fn cylinder(radius: f32, height: f32, segments: u32, out: &mut Vec<MeshTri>) {
     }
 }
 
+/// A surface of revolution. The profile's slope gives smooth normals (averaged at interior
+/// points so a curved vase shades smoothly); V runs along the profile's arc length in metres.
+fn lathe(profile: &[[f32; 2]], segments: u32, out: &mut Vec<MeshTri>) {
+    if profile.len() < 2 {
+        return;
+    }
+    let p: Vec<Vec2> = profile.iter().map(|&[r, y]| Vec2::new(r, y)).collect();
+    let arc: Vec<f32> = std::iter::once(0.0)
+        .chain(p.windows(2).scan(0.0, |s, w| {
+            *s += w[0].distance(w[1]);
+            Some(*s)
+        }))
+        .collect();
+    // Outward 2-D normal (radius, height) of each profile edge, averaged at shared points.
+    let edge_n: Vec<Vec2> = p
+        .windows(2)
+        .map(|w| {
+            let d = w[1] - w[0];
+            Vec2::new(d.y, -d.x).normalize_or_zero()
+        })
+        .collect();
+    let point_n = |i: usize| {
+        let a = edge_n[i.saturating_sub(1).min(edge_n.len() - 1)];
+        let b = edge_n[i.min(edge_n.len() - 1)];
+        (a + b).normalize_or(b)
+    };
+    let last = p.len() - 1;
+    // Rows run down the profile (as the cylinder's side), which makes the winding outward.
+    let f = |i: u32, j: u32| {
+        let phi = TAU * j as f32 / segments as f32;
+        let (s, c) = phi.sin_cos();
+        let k = last - i as usize;
+        let (q, n2) = (p[k], point_n(k));
+        let pos = Vec3::new(q.x * c, q.y, -q.x * s);
+        let n = Vec3::new(n2.x * c, n2.y, -n2.x * s).normalize_or(Vec3::Y);
+        let uv = Vec2::new(phi * q.x.abs().max(0.01), arc[k]);
+        (pos, n, uv)
+    };
+    grid_mesh(p.len() as u32 - 1, segments, f, out);
+}
+
 /// Triangulates a `rows × cols` parametric patch; `f(i, j)` gives position, normal and UV.
 /// Degenerate triangles (at the poles) are skipped.
 fn grid_mesh(
@@ -220,6 +265,12 @@ mod tests {
             segments: 256,
         }));
         assert!((v - PI * 0.5).abs() < 0.01, "{v}");
+        // A closed lathe cylinder (axis → rim → rim → axis) has the cylinder's volume.
+        let v = volume(&tris(Shape::Lathe {
+            profile: vec![[0.0, 0.0], [0.5, 0.0], [0.5, 2.0], [0.0, 2.0]],
+            segments: 256,
+        }));
+        assert!((v - PI * 0.5).abs() < 0.01, "{v}");
     }
 
     #[test]
@@ -237,6 +288,10 @@ mod tests {
                 segments: 16,
             },
             Shape::Quad { size: [1.0, 2.0] },
+            Shape::Lathe {
+                profile: vec![[0.0, 0.0], [0.3, 0.1], [0.2, 0.5], [0.25, 0.8], [0.0, 0.9]],
+                segments: 24,
+            },
         ] {
             for t in tris(shape.clone()) {
                 let ng = (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]);

@@ -131,6 +131,7 @@ pub fn scene(
         materials,
         objects,
         lights: Vec::new(),
+        placement: None,
         sources: Vec::new(),
     }
 }

@@ -85,7 +85,10 @@ impl GltfFile {
     /// Vertex indices of the primitive's triangles, every one checked against `n` vertices.
     fn triangle_indices(&self, p: &::gltf::Primitive, n: usize, of: &str) -> Result<Vec<u32>> {
         let Some(acc) = p.indices() else {
-            ensure!(n.is_multiple_of(3), "{of}: {n} vertices do not make whole triangles");
+            ensure!(
+                n.is_multiple_of(3),
+                "{of}: {n} vertices do not make whole triangles"
+            );
             return Ok((0..n as u32).collect());
         };
         let what = format!("indices of {of}");

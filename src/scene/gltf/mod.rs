@@ -75,6 +75,7 @@ fn import_file(path: &Path, cfg: &Config) -> Result<Imported> {
         materials,
         objects,
         lights,
+        placement: None,
         sources: Vec::new(),
     };
     let assets = Assets::from_files(&desc, std::slice::from_ref(&file))?;
