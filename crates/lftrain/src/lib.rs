@@ -1,1 +1,30 @@
+//! Training of the thesis' light-field posterior models (crate `lftrain`).
+//!
+//! Trains the four models of thesis §5.2.1 — BASE (a disparity), UPR (a Laplacian), ESE (the
+//! UPR network with a masked loss, ensembled over EPI shifts at inference) and DPP (a softmax
+//! over disparity bins) — on an EPINET-style network (appendix B.1) with burn, on lfgen
+//! datasets (multimodal ground truth) or plain HCI scenes, and writes predictions in the
+//! formats `lfeval` reads.
+//!
+//! Layout: the data pipeline is [`lightfield`] (views, crop, rotation), [`stacks`] (the four
+//! stacks and the EPI shift), [`augment`] (colours), [`scene`] (targets), [`sample`] (one
+//! augmented crop, batches) and [`loader`] (background prefetch); the learning side is
+//! [`model`], [`loss`] and [`tensors`]; [`train`], [`validate`], [`predict`], [`run`] (the run
+//! folder) and [`log`] are the commands' machinery; [`config`] holds every setting.
 
+pub mod augment;
+pub mod config;
+pub mod lightfield;
+pub mod loader;
+pub mod log;
+pub mod loss;
+pub mod model;
+pub mod predict;
+pub mod run;
+pub mod sample;
+pub mod scene;
+pub mod stacks;
+pub mod synthetic;
+pub mod tensors;
+pub mod train;
+pub mod validate;

@@ -1,0 +1,239 @@
+//! Training configuration: one TOML file (every field optional) plus a few command-line
+//! overrides, stored in the run folder so that `--resume` and `predict` rebuild the same model.
+
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+use clap::ValueEnum;
+use serde::{Deserialize, Serialize};
+
+/// The four posterior models of the thesis (§5.2.1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum ModelKind {
+    /// One disparity per pixel, L1 loss.
+    Base,
+    /// Unimodal posterior regression: a Laplacian (μ, log b).
+    Upr,
+    /// EPI-shift ensemble: the UPR network with a masked loss, M shifted passes at inference.
+    Ese,
+    /// Discrete posterior prediction: a softmax over disparity bins.
+    Dpp,
+}
+
+impl ModelKind {
+    /// Network output channels.
+    pub fn out_channels(self, dpp_bins: usize) -> usize {
+        match self {
+            ModelKind::Base => 1,
+            ModelKind::Upr | ModelKind::Ese => 2,
+            ModelKind::Dpp => dpp_bins,
+        }
+    }
+
+    /// Lower-case name (file and log names).
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelKind::Base => "base",
+            ModelKind::Upr => "upr",
+            ModelKind::Ese => "ese",
+            ModelKind::Dpp => "dpp",
+        }
+    }
+}
+
+/// Widths and depths of the EPINET-style network; defaults are appendix B.1 (Tables B.2, B.3).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct NetConfig {
+    /// Channels of each input-stream block (70).
+    pub stream_width: usize,
+    /// Blocks per input stream (3).
+    pub stream_blocks: usize,
+    /// Channels of the output-stream blocks (280 = 4 × 70 in the thesis).
+    pub head_width: usize,
+    /// Output-stream blocks at `head_width`, before the final block to the output channels (7).
+    pub head_blocks: usize,
+}
+
+impl Default for NetConfig {
+    fn default() -> Self {
+        Self {
+            stream_width: 70,
+            stream_blocks: 3,
+            head_width: 280,
+            head_blocks: 7,
+        }
+    }
+}
+
+/// Data augmentation of the thesis (§5.3.1); each can be switched off.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct AugmentConfig {
+    /// Random EPI shift drawn uniformly from `[-max_shift, max_shift]` pixels (thesis: 2).
+    pub max_shift: f32,
+    /// Random rotation by multiples of 90° (square view grids only).
+    pub rotate: bool,
+    /// Random rotation of the colours about the grey axis of RGB space.
+    pub colour_rotation: bool,
+    /// Brightness offset drawn from `[-brightness, brightness]`.
+    pub brightness: f32,
+    /// Contrast factor drawn from `[1 - contrast, 1 + contrast]`.
+    pub contrast: f32,
+}
+
+impl Default for AugmentConfig {
+    fn default() -> Self {
+        Self {
+            max_shift: 2.0,
+            rotate: true,
+            colour_rotation: true,
+            brightness: 0.1,
+            contrast: 0.2,
+        }
+    }
+}
+
+/// The ESE's shift spacing and ensemble size (thesis §5.2.1, eq. 5.12).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct EseConfig {
+    /// Δd: the loss applies where `|d| < Δd/2`, inference shifts are `k Δd`.
+    pub delta: f32,
+    /// M: inference passes at `s_k = k Δd`, `k = -(M-1)/2 ..= (M-1)/2`.
+    pub members: usize,
+}
+
+impl Default for EseConfig {
+    fn default() -> Self {
+        Self {
+            delta: 1.0,
+            members: 7,
+        }
+    }
+}
+
+/// The DPP's disparity bins (thesis: 108 over [-3.5, 3.5]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DppConfig {
+    /// Number of bins.
+    pub bins: usize,
+    /// Lower edge of the first bin, pixels.
+    pub min: f32,
+    /// Upper edge of the last bin, pixels.
+    pub max: f32,
+}
+
+impl Default for DppConfig {
+    fn default() -> Self {
+        Self {
+            bins: 108,
+            min: -3.5,
+            max: 3.5,
+        }
+    }
+}
+
+/// Everything a run needs besides the dataset paths.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TrainConfig {
+    /// Which model.
+    pub model: ModelKind,
+    /// Train against all modes weighted by η instead of the front-most one.
+    pub multimodal: bool,
+    /// Side of the square training crops (thesis: 96).
+    pub patch: usize,
+    /// Crops per step (thesis: 512 on GPUs).
+    pub batch: usize,
+    /// Optimiser steps in total.
+    pub steps: usize,
+    /// Adam learning rate (thesis: 1e-3).
+    pub learning_rate: f64,
+    /// Modes kept per pixel for multimodal targets (the thesis' loader: 12).
+    pub max_modes: usize,
+    /// Validate every this many steps (0: only at the end).
+    pub val_every: usize,
+    /// Write a checkpoint every this many steps (0: only at the end).
+    pub checkpoint_every: usize,
+    /// Pixels left out at each side when validating (HCI: 15).
+    pub val_border: usize,
+    /// Batches prepared ahead of the optimiser.
+    pub prefetch: usize,
+    /// Seed of the data sampling and the weight initialisation.
+    pub seed: u64,
+    /// Network shape.
+    pub net: NetConfig,
+    /// Augmentations.
+    pub augment: AugmentConfig,
+    /// ESE settings.
+    pub ese: EseConfig,
+    /// DPP settings.
+    pub dpp: DppConfig,
+}
+
+impl Default for TrainConfig {
+    fn default() -> Self {
+        Self {
+            model: ModelKind::Base,
+            multimodal: false,
+            patch: 96,
+            batch: 16,
+            steps: 10_000,
+            learning_rate: 1e-3,
+            max_modes: 12,
+            val_every: 500,
+            checkpoint_every: 500,
+            val_border: 15,
+            prefetch: 4,
+            seed: 0,
+            net: NetConfig::default(),
+            augment: AugmentConfig::default(),
+            ese: EseConfig::default(),
+            dpp: DppConfig::default(),
+        }
+    }
+}
+
+impl TrainConfig {
+    /// Reads a TOML file; missing fields keep their defaults, unknown ones are errors.
+    pub fn read(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("{}: cannot read config", path.display()))?;
+        let cfg: Self =
+            toml::from_str(&text).with_context(|| format!("{}: invalid config", path.display()))?;
+        cfg.validate()
+            .with_context(|| format!("{}: invalid config", path.display()))?;
+        Ok(cfg)
+    }
+
+    /// Writes the config as TOML.
+    pub fn write(&self, path: &Path) -> Result<()> {
+        let text = toml::to_string_pretty(self).context("cannot serialise config")?;
+        std::fs::write(path, text).with_context(|| format!("{}: cannot write", path.display()))
+    }
+
+    /// Rejects settings that would fail later with an obscure tensor error.
+    pub fn validate(&self) -> Result<()> {
+        if self.patch < 2 || self.batch == 0 || self.max_modes == 0 {
+            bail!("patch must be ≥ 2, batch and max_modes ≥ 1");
+        }
+        if self.net.stream_width == 0 || self.net.head_width == 0 {
+            bail!("network widths must be ≥ 1");
+        }
+        if self.dpp.bins < 2 || self.dpp.max <= self.dpp.min {
+            bail!("dpp needs ≥ 2 bins over a non-empty range");
+        }
+        if self.ese.members == 0 || self.ese.members.is_multiple_of(2) || self.ese.delta <= 0.0 {
+            bail!("ese.members must be odd and ese.delta positive");
+        }
+        Ok(())
+    }
+
+    /// Modes per pixel in the targets: all (up to `max_modes`) or only the front-most.
+    pub fn target_modes(&self) -> usize {
+        if self.multimodal { self.max_modes } else { 1 }
+    }
+}

@@ -1,0 +1,213 @@
+//! A light field in memory (the views the four stacks need), with the geometric operations of
+//! the data pipeline: cropping and rotation by 90°.
+//!
+//! Views are addressed by grid column `u` and row `v` (row 0 on top, as HCI's file index
+//! `v * n + u`); pixels are RGB in `[0, 1]`, row-major, top row first. Only the star (centre row,
+//! column and both diagonals) is loaded: the other views are never used by an EPINET network,
+//! and leaving them out cuts memory by 2.5× on a 9×9 grid.
+
+use std::path::Path;
+
+use anyhow::{Result, bail};
+use lfeval::baseline::views::{ViewSet, read_rgb};
+use lfeval::dataset::PARAMETERS_FILE;
+use lfformat::HciParameters;
+
+/// The star views of a square `n × n` camera grid.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightField {
+    /// Views per grid side (odd).
+    pub n: usize,
+    /// Image columns.
+    pub width: usize,
+    /// Image rows.
+    pub height: usize,
+    /// `n * n` entries, index `v * n + u`; `None` off the star.
+    pub views: Vec<Option<Vec<f32>>>,
+}
+
+impl LightField {
+    /// Reads `parameters.cfg` and the star views of the scene folder `dir`.
+    pub fn load(dir: &Path) -> Result<Self> {
+        let params = HciParameters::read(&dir.join(PARAMETERS_FILE))?;
+        let (nx, ny) = (params.num_cams_x as usize, params.num_cams_y as usize);
+        if nx != ny || nx.is_multiple_of(2) {
+            bail!(
+                "{}: a {nx}x{ny} camera grid; the four stacks need a square grid with an odd side",
+                dir.display()
+            );
+        }
+        let (width, height) = (
+            params.image_resolution_x_px as usize,
+            params.image_resolution_y_px as usize,
+        );
+        let mut views = vec![None; nx * nx];
+        for (u, v) in ViewSet::Star.positions(nx, nx) {
+            let path = dir.join(format!("input_Cam{:03}.png", v * nx + u));
+            views[v * nx + u] = Some(read_rgb(&path, width, height)?);
+        }
+        Ok(Self {
+            n: nx,
+            width,
+            height,
+            views,
+        })
+    }
+
+    /// Builds a light field from a function of grid position and pixel, for every star view
+    /// (synthetic scenes in tests and examples).
+    pub fn from_fn(
+        n: usize,
+        width: usize,
+        height: usize,
+        f: impl Fn(usize, usize, usize, usize) -> [f32; 3],
+    ) -> Self {
+        let mut views = vec![None; n * n];
+        for (u, v) in ViewSet::Star.positions(n, n) {
+            let mut rgb = Vec::with_capacity(width * height * 3);
+            for y in 0..height {
+                for x in 0..width {
+                    rgb.extend_from_slice(&f(u, v, x, y));
+                }
+            }
+            views[v * n + u] = Some(rgb);
+        }
+        Self {
+            n,
+            width,
+            height,
+            views,
+        }
+    }
+
+    /// Index of the centre view (`Cam040` of 9×9).
+    pub fn centre(&self) -> usize {
+        self.n / 2
+    }
+
+    /// The view at column `u`, row `v`.
+    ///
+    /// # Panics
+    /// If the view is not on the star (a stack geometry bug, not a data error).
+    pub fn view(&self, u: usize, v: usize) -> &[f32] {
+        self.views[v * self.n + u]
+            .as_deref()
+            .unwrap_or_else(|| panic!("view ({u}, {v}) is not on the star"))
+    }
+
+    /// The `w × h` region at `(x0, y0)` (which may reach outside the image: edge pixels are
+    /// repeated, the thesis' nearest-neighbour padding).
+    pub fn crop(&self, x0: isize, y0: isize, w: usize, h: usize) -> Self {
+        let views = self
+            .views
+            .iter()
+            .map(|view| {
+                view.as_ref()
+                    .map(|rgb| crop_plane(rgb, self.width, self.height, 3, (x0, y0), (w, h)))
+            })
+            .collect();
+        Self {
+            n: self.n,
+            width: w,
+            height: h,
+            views,
+        }
+    }
+
+    /// The light field rotated by 90° (see [`rotate_plane`]): every image is rotated and the
+    /// view grid is rotated the same way, so that disparities keep their values and signs.
+    ///
+    /// A point at centre-relative image position `p` and view offset `w` moves to `R p` and
+    /// `R w` with the same linear map `R`; since a point of disparity `d` appears at `p - d w`
+    /// in view `w`, it appears at `R p - d R w` after the rotation: same disparity.
+    pub fn rotate90(&self) -> Self {
+        let n = self.n;
+        let views = (0..n * n)
+            .map(|i| {
+                let (u, v) = (i % n, i / n);
+                let (ou, ov) = rotate_source(u, v, n, n);
+                self.views[ov * n + ou]
+                    .as_ref()
+                    .map(|rgb| rotate_plane(rgb, self.width, self.height, 3))
+            })
+            .collect();
+        Self {
+            n,
+            width: self.height,
+            height: self.width,
+            views,
+        }
+    }
+
+    /// Rotated by `quarter_turns` × 90°.
+    pub fn rotate(&self, quarter_turns: usize) -> Self {
+        (0..quarter_turns % 4).fold(self.clone(), |lf, _| lf.rotate90())
+    }
+}
+
+/// The source `(x, y)` of target pixel `(x', y')` of the 90° rotation of a `w × h` grid:
+/// `(w - 1 - y', x')`. In centre-relative coordinates this is `R(a, b) = (b, -a)`: a
+/// quarter turn counter-clockwise as displayed (x right, y down). Pixels and views share it.
+pub fn rotate_source(xr: usize, yr: usize, w: usize, _h: usize) -> (usize, usize) {
+    (w - 1 - yr, xr)
+}
+
+/// A `w × h` image with `channels` interleaved values per pixel rotated by 90° (the result is
+/// `h × w`), see [`rotate_source`].
+pub fn rotate_plane<T: Copy>(data: &[T], w: usize, h: usize, channels: usize) -> Vec<T> {
+    let (wr, hr) = (h, w);
+    let mut out = Vec::with_capacity(data.len());
+    for yr in 0..hr {
+        for xr in 0..wr {
+            let (x, y) = rotate_source(xr, yr, w, h);
+            let i = (y * w + x) * channels;
+            out.extend_from_slice(&data[i..i + channels]);
+        }
+    }
+    out
+}
+
+/// The `size` region at `origin` of a `w × h` image with `channels` values per pixel,
+/// coordinates clamped to the image.
+pub fn crop_plane<T: Copy>(
+    data: &[T],
+    w: usize,
+    h: usize,
+    channels: usize,
+    (x0, y0): (isize, isize),
+    (cw, ch): (usize, usize),
+) -> Vec<T> {
+    let mut out = Vec::with_capacity(cw * ch * channels);
+    for y in 0..ch as isize {
+        let sy = (y0 + y).clamp(0, h as isize - 1) as usize;
+        for x in 0..cw as isize {
+            let sx = (x0 + x).clamp(0, w as isize - 1) as usize;
+            let i = (sy * w + sx) * channels;
+            out.extend_from_slice(&data[i..i + channels]);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rotation_of_a_plane_is_a_quarter_turn() {
+        // 3 × 2 image:  0 1 2 / 3 4 5  → quarter turn counter-clockwise: 2 5 / 1 4 / 0 3
+        let img: Vec<u8> = (0..6).collect();
+        assert_eq!(rotate_plane(&img, 3, 2, 1), vec![2, 5, 1, 4, 0, 3]);
+        let four = (0..4).fold(img.clone(), |a, i| {
+            let (w, h) = if i % 2 == 0 { (3, 2) } else { (2, 3) };
+            rotate_plane(&a, w, h, 1)
+        });
+        assert_eq!(four, img);
+    }
+
+    #[test]
+    fn crop_repeats_edge_pixels() {
+        let img: Vec<u8> = (0..4).collect(); // 2 × 2
+        assert_eq!(crop_plane(&img, 2, 2, 1, (-1, 0), (3, 1)), vec![0, 0, 1]);
+    }
+}

@@ -1,0 +1,129 @@
+//! Batches prepared on a background thread ahead of the optimiser, from a bounded pool of
+//! scenes in memory.
+//!
+//! Memory is bounded twice: at most `scene_pool` scenes are held (a random one is replaced by a
+//! random other scene every `pool_refresh` batches, so a large dataset is still visited
+//! evenly), and at most `prefetch` finished batches wait in the channel. The samples of a batch
+//! are built in parallel with rayon.
+
+use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
+use std::thread::JoinHandle;
+
+use anyhow::{Context, Result, bail};
+use lfeval::dataset::SceneDir;
+use rand::RngExt;
+use rand_pcg::Pcg32;
+use rayon::prelude::*;
+
+use crate::config::TrainConfig;
+use crate::sample::{Batch, Draw, make_sample};
+use crate::scene::Scene;
+
+/// Pool and refresh sizes of the loader.
+#[derive(Clone, Copy, Debug)]
+pub struct PoolConfig {
+    /// Scenes held in memory.
+    pub scenes: usize,
+    /// Batches between two scene replacements.
+    pub refresh: usize,
+}
+
+/// The receiving end of the background loader; dropping it stops the thread.
+pub struct Loader {
+    rx: Receiver<Result<Batch>>,
+    handle: Option<JoinHandle<()>>,
+}
+
+impl Loader {
+    /// Starts loading batches of `scenes` under `cfg`; `stream` separates the random streams
+    /// of resumed runs from the original one.
+    pub fn start(
+        scenes: Vec<SceneDir>,
+        cfg: TrainConfig,
+        pool: PoolConfig,
+        stream: u64,
+    ) -> Result<Self> {
+        if scenes.is_empty() {
+            bail!("no training scenes");
+        }
+        let (tx, rx) = sync_channel(cfg.prefetch.max(1));
+        let handle = std::thread::Builder::new()
+            .name("lftrain-loader".into())
+            .spawn(move || run(scenes, cfg, pool, stream, tx))
+            .context("cannot start the loader thread")?;
+        Ok(Self {
+            rx,
+            handle: Some(handle),
+        })
+    }
+
+    /// The next batch (blocks until ready).
+    pub fn next_batch(&self) -> Result<Batch> {
+        self.rx
+            .recv()
+            .context("the loader thread stopped unexpectedly")?
+    }
+}
+
+impl Drop for Loader {
+    fn drop(&mut self) {
+        // Closing the channel makes the thread's next send fail, which ends it.
+        let (_, dead) = sync_channel(1);
+        drop(std::mem::replace(&mut self.rx, dead));
+        if let Some(h) = self.handle.take() {
+            let _ = h.join();
+        }
+    }
+}
+
+/// The loader thread: fills the pool, then sends batches until the receiver is gone.
+fn run(
+    dirs: Vec<SceneDir>,
+    cfg: TrainConfig,
+    pool_cfg: PoolConfig,
+    stream: u64,
+    tx: SyncSender<Result<Batch>>,
+) {
+    let mut rng = Pcg32::new(cfg.seed, stream);
+    let load = |d: &SceneDir| Scene::load(&d.path, &d.name, cfg.target_modes());
+    let initial: Vec<&SceneDir> = dirs.iter().take(pool_cfg.scenes.max(1)).collect();
+    let mut pool = match initial
+        .into_par_iter()
+        .map(load)
+        .collect::<Result<Vec<_>>>()
+    {
+        Ok(p) => p,
+        Err(e) => {
+            let _ = tx.send(Err(e));
+            return;
+        }
+    };
+    for batch_index in 0u64.. {
+        let refresh = pool_cfg.refresh.max(1) as u64;
+        if dirs.len() > pool.len() && batch_index > 0 && batch_index % refresh == 0 {
+            let slot = rng.random_range(0..pool.len());
+            match load(&dirs[rng.random_range(0..dirs.len())]) {
+                Ok(s) => pool[slot] = s,
+                Err(e) => {
+                    let _ = tx.send(Err(e));
+                    return;
+                }
+            }
+        }
+        let seeds: Vec<u64> = (0..cfg.batch).map(|_| rng.random()).collect();
+        let samples = seeds
+            .into_par_iter()
+            .map(|seed| {
+                let mut r = Pcg32::new(seed, stream);
+                let scene = &pool[r.random_range(0..pool.len())];
+                let size = (scene.lf.width, scene.lf.height);
+                let draw = Draw::random(&cfg.augment, cfg.patch, size, &mut r);
+                make_sample(scene, &draw, cfg.patch)
+            })
+            .collect();
+        let batch = Batch::from_samples(samples, cfg.patch, cfg.target_modes());
+        if tx.send(Ok(batch)).is_err() {
+            return;
+        }
+    }
+}

@@ -1,0 +1,74 @@
+//! The training losses of thesis §5.2.1 on network outputs `[B, C, H, W]` and targets
+//! `[B, L, H, W]` (disparity `d_j` and weight `η_j` per slot; the unimodal case is `L = 1` with
+//! the front-most mode and `η = 1`, so one formula serves both). Every loss is the sum over
+//! pixels and modes of `η_j ℓ(d_j)`, divided by the number of pixels `N` (eq. 5.4–5.16).
+
+use burn::prelude::*;
+use burn::tensor::activation::log_softmax;
+
+use crate::config::{DppConfig, ModelKind, TrainConfig};
+
+/// Targets on the device.
+pub struct TargetTensors {
+    /// `[B, L, H, W]` disparities.
+    pub disparity: Tensor<4>,
+    /// `[B, L, H, W]` weights (0 for unused slots).
+    pub eta: Tensor<4>,
+    /// `[B, L, H, W]` DPP bin of each disparity (DPP only).
+    pub bins: Option<Tensor<4, Int>>,
+}
+
+/// The DPP bin of disparity `d`: equal bins over `[min, max]`, the outer ones open-ended
+/// (as lfeval's KLD bins), so a mode outside the range still pulls towards the nearest end.
+pub fn dpp_bin(d: f32, cfg: &DppConfig) -> i64 {
+    let h = (cfg.max - cfg.min) / cfg.bins as f32;
+    (((d - cfg.min) / h).floor() as i64).clamp(0, cfg.bins as i64 - 1)
+}
+
+/// The loss of model `kind` (scalar tensor).
+pub fn loss(cfg: &TrainConfig, out: Tensor<4>, t: &TargetTensors) -> Tensor<1> {
+    match cfg.model {
+        ModelKind::Base => l1(out, t),
+        ModelKind::Upr => laplace_nll(out, t, t.eta.clone()),
+        ModelKind::Ese => {
+            let inside = t.disparity.clone().abs().lower_elem(cfg.ese.delta / 2.0);
+            laplace_nll(out, t, t.eta.clone() * inside.float())
+        }
+        ModelKind::Dpp => cross_entropy(out, t),
+    }
+}
+
+/// `[B, L, H, W]` broadcast of output channel `c`.
+fn channel(out: &Tensor<4>, c: usize, like: &Tensor<4>) -> Tensor<4> {
+    out.clone().narrow(1, c, 1).expand(like.shape())
+}
+
+/// Number of pixels `B·H·W`.
+fn pixels(t: &Tensor<4>) -> f32 {
+    let [b, _, h, w] = t.shape().dims();
+    (b * h * w) as f32
+}
+
+/// BASE: `Σ_j η_j |d_j − f|` (eq. 5.4, 5.8).
+fn l1(out: Tensor<4>, t: &TargetTensors) -> Tensor<1> {
+    let f = channel(&out, 0, &t.disparity);
+    let n = pixels(&t.disparity);
+    (t.eta.clone() * (t.disparity.clone() - f).abs()).sum() / n
+}
+
+/// UPR / ESE: `Σ_j w_j (|d_j − μ| / b + log b)` with channels `μ`, `log b` (eq. 5.6, 5.7, 5.13).
+fn laplace_nll(out: Tensor<4>, t: &TargetTensors, weights: Tensor<4>) -> Tensor<1> {
+    let mu = channel(&out, 0, &t.disparity);
+    let log_b = channel(&out, 1, &t.disparity);
+    let n = pixels(&t.disparity);
+    let nll = (t.disparity.clone() - mu).abs() * log_b.clone().neg().exp() + log_b;
+    (weights * nll).sum() / n
+}
+
+/// DPP: `−Σ_j η_j log softmax(z)_{bin(d_j)}` (eq. 5.15, 5.16).
+fn cross_entropy(out: Tensor<4>, t: &TargetTensors) -> Tensor<1> {
+    let bins = t.bins.clone().expect("DPP targets carry bin indices");
+    let log_q = log_softmax(out, 1).gather(1, bins);
+    let n = pixels(&t.disparity);
+    (t.eta.clone() * log_q).sum().neg() / n
+}

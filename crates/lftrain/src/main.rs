@@ -1,0 +1,170 @@
+//! `lftrain`: train the thesis' posterior models and write predictions for `lfeval`.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::Result;
+use clap::{Args, Parser, Subcommand};
+use lftrain::config::{ModelKind, TrainConfig};
+use lftrain::loader::PoolConfig;
+use lftrain::predict::predict_dataset;
+use lftrain::train::{TrainArgs, bench_steps, train};
+
+#[derive(Parser)]
+#[command(
+    version,
+    about = "Train light-field depth posterior models (BASE, UPR, ESE, DPP)"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+    /// Worker threads (default: all cores).
+    #[arg(long, global = true)]
+    threads: Option<usize>,
+    /// No progress bar.
+    #[arg(short, long, global = true)]
+    quiet: bool,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Train a model; writes RUN/config.toml, RUN/checkpoint/, RUN/log.csv, log.json, loss.png.
+    Train(TrainCmd),
+    /// Apply a trained run to a dataset; writes lfeval's prediction folders under --out.
+    Predict {
+        /// Run folder of `lftrain train`.
+        run: PathBuf,
+        /// Dataset (root with split folders, split folder, or scene folder).
+        dataset: PathBuf,
+        /// Output folder (one lfeval method).
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Seconds per training step of a configuration on random input (no data loading).
+    Bench {
+        /// TOML config (network, batch, patch, model).
+        #[arg(long)]
+        config: Option<PathBuf>,
+        /// Model; overrides the config file.
+        #[arg(long, value_enum)]
+        model: Option<ModelKind>,
+        /// Views per grid side.
+        #[arg(long, default_value_t = 9)]
+        grid: usize,
+        /// Timed steps (after one warm-up step).
+        #[arg(long, default_value_t = 5)]
+        steps: usize,
+    },
+}
+
+#[derive(Args)]
+struct TrainCmd {
+    /// Model; overrides the config file.
+    #[arg(long, value_enum)]
+    model: Option<ModelKind>,
+    /// Train on all modes weighted by η (lfgen datasets) instead of the front-most one.
+    #[arg(long)]
+    multimodal: bool,
+    /// Training dataset.
+    #[arg(long)]
+    train: PathBuf,
+    /// Validation dataset (validated every `val_every` steps through lfeval's metrics).
+    #[arg(long)]
+    val: Option<PathBuf>,
+    /// Run folder.
+    #[arg(long)]
+    out: PathBuf,
+    /// TOML config (see README); fields left out keep their defaults.
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Continue the run in --out from its checkpoint (its stored config is used).
+    #[arg(long)]
+    resume: bool,
+    /// Total steps; overrides the config file (with --resume: extends the run).
+    #[arg(long)]
+    steps: Option<usize>,
+    /// Scenes held in memory by the loader.
+    #[arg(long, default_value_t = 16)]
+    scene_pool: usize,
+    /// Batches between two scene replacements in the pool.
+    #[arg(long, default_value_t = 8)]
+    pool_refresh: usize,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("lftrain: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    if let Some(n) = cli.threads {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()?;
+    }
+    match cli.command {
+        Command::Train(t) => {
+            let mut cfg = match &t.config {
+                Some(path) => TrainConfig::read(path)?,
+                None => TrainConfig::default(),
+            };
+            if let Some(m) = t.model {
+                cfg.model = m;
+            }
+            cfg.multimodal |= t.multimodal;
+            let args = TrainArgs {
+                train: t.train,
+                val: t.val,
+                out: t.out,
+                resume: t.resume,
+                quiet: cli.quiet,
+                pool: PoolConfig {
+                    scenes: t.scene_pool,
+                    refresh: t.pool_refresh,
+                },
+                steps: t.steps,
+            };
+            let summary = train(cfg, &args)?;
+            eprintln!(
+                "lftrain: {} steps logged, {:.3} s per step",
+                summary.records.len(),
+                summary.seconds_per_step
+            );
+        }
+        Command::Bench {
+            config,
+            model,
+            grid,
+            steps,
+        } => {
+            let mut cfg = match &config {
+                Some(path) => TrainConfig::read(path)?,
+                None => TrainConfig::default(),
+            };
+            if let Some(m) = model {
+                cfg.model = m;
+            }
+            let (s, params) = bench_steps(&cfg, grid, steps)?;
+            println!(
+                "{} ({params} parameter values incl. batch-norm statistics): batch {} of {}x{} patches, {grid}x{grid} views: \
+                 {s:.3} s per step ({:.1} samples/s)",
+                cfg.model.name(),
+                cfg.batch,
+                cfg.patch,
+                cfg.patch,
+                cfg.batch as f64 / s
+            );
+        }
+        Command::Predict { run, dataset, out } => {
+            let n = predict_dataset(&run, &dataset, &out, cli.quiet)?;
+            eprintln!("lftrain: {n} scenes written to {}", out.display());
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,123 @@
+//! The EPINET-style network of thesis appendix B.1: two weight-shared input streams for the
+//! four stacks, concatenated features, an output stream and a final block to the head's
+//! channels. Every width and depth comes from [`NetConfig`].
+
+use burn::nn::conv::{Conv2d, Conv2dConfig};
+use burn::nn::{BatchNorm, BatchNormConfig, PaddingConfig2d};
+use burn::prelude::*;
+use burn::tensor::activation::relu;
+
+use crate::config::NetConfig;
+
+/// A 2×2 convolution; `grow` pads by one on every side (size + 1), otherwise none (size − 1):
+/// the thesis alternates the two so that every block keeps the image size.
+fn conv2x2(cin: usize, cout: usize, grow: bool, device: &Device) -> Conv2d {
+    let padding = if grow {
+        PaddingConfig2d::Explicit(1, 1, 1, 1)
+    } else {
+        PaddingConfig2d::Valid
+    };
+    Conv2dConfig::new([cin, cout], [2, 2])
+        .with_padding(padding)
+        .init(device)
+}
+
+/// `2×2 conv → ReLU → 2×2 conv → BN → ReLU` (Tables B.2, B.3).
+#[derive(Module, Debug)]
+pub struct Block {
+    first: Conv2d,
+    second: Conv2d,
+    norm: BatchNorm,
+}
+
+impl Block {
+    /// A block from `cin` to `cout` channels.
+    pub fn new(cin: usize, cout: usize, device: &Device) -> Self {
+        Self {
+            first: conv2x2(cin, cout, true, device),
+            second: conv2x2(cout, cout, false, device),
+            norm: BatchNormConfig::new(cout).init(device),
+        }
+    }
+
+    /// Same spatial size out as in.
+    pub fn forward(&self, x: Tensor<4>) -> Tensor<4> {
+        let x = relu(self.first.forward(x));
+        relu(self.norm.forward(self.second.forward(x)))
+    }
+}
+
+/// A chain of blocks.
+fn chain(blocks: &[Block], x: Tensor<4>) -> Tensor<4> {
+    blocks.iter().fold(x, |x, b| b.forward(x))
+}
+
+/// `count` blocks, the first from `cin`, all to `width`.
+fn blocks(cin: usize, width: usize, count: usize, device: &Device) -> Vec<Block> {
+    (0..count)
+        .map(|i| Block::new(if i == 0 { cin } else { width }, width, device))
+        .collect()
+}
+
+/// Quarter turn of `[B, C, H, W]` images that maps the 90° stack's EPIs onto the 0° stack's
+/// (and the 45° stack onto the −45° one): `new[i][j] = old[H-1-j][i]`, i.e. the centred map
+/// `(x, y) → (-y, x)` (clockwise as displayed). See [`crate::stacks`] for the stack order.
+pub fn turn_to_reference(x: Tensor<4>) -> Tensor<4> {
+    x.swap_dims(2, 3).flip([3])
+}
+
+/// Inverse of [`turn_to_reference`]: `new[i][j] = old[j][W-1-i]`.
+pub fn turn_back(x: Tensor<4>) -> Tensor<4> {
+    x.swap_dims(2, 3).flip([2])
+}
+
+/// The network.
+#[derive(Module, Debug)]
+pub struct EpiNet {
+    /// Shared by the 0° and (turned) 90° stacks.
+    straight: Vec<Block>,
+    /// Shared by the −45° and (turned) 45° stacks.
+    diagonal: Vec<Block>,
+    /// Output stream at the head width.
+    head: Vec<Block>,
+    /// Final block: conv to the output channels, ReLU, conv (Table B.3).
+    last_first: Conv2d,
+    last_second: Conv2d,
+}
+
+impl EpiNet {
+    /// A freshly initialised network for stacks of `stack_channels` (views × 3) channels.
+    pub fn new(cfg: &NetConfig, stack_channels: usize, out: usize, device: &Device) -> Self {
+        let sw = cfg.stream_width;
+        let streams_out = if cfg.stream_blocks == 0 {
+            stack_channels
+        } else {
+            sw
+        };
+        let head_out = if cfg.head_blocks == 0 {
+            4 * streams_out
+        } else {
+            cfg.head_width
+        };
+        Self {
+            straight: blocks(stack_channels, sw, cfg.stream_blocks, device),
+            diagonal: blocks(stack_channels, sw, cfg.stream_blocks, device),
+            head: blocks(4 * streams_out, cfg.head_width, cfg.head_blocks, device),
+            last_first: conv2x2(head_out, out, true, device),
+            last_second: conv2x2(out, out, false, device),
+        }
+    }
+
+    /// Raw outputs `[B, out, H, W]` for the stacks `[0°, 90°, 45°, −45°]`, each `[B, C, H, W]`.
+    pub fn forward(&self, stacks: [Tensor<4>; 4]) -> Tensor<4> {
+        let [h, v, d45, dm45] = stacks;
+        let features = vec![
+            chain(&self.straight, h),
+            turn_back(chain(&self.straight, turn_to_reference(v))),
+            turn_back(chain(&self.diagonal, turn_to_reference(d45))),
+            chain(&self.diagonal, dm45),
+        ];
+        let x = chain(&self.head, Tensor::cat(features, 1));
+        self.last_second.forward(relu(self.last_first.forward(x)))
+    }
+}

@@ -1,0 +1,157 @@
+//! Inference on whole scenes, turned into lfeval's prediction formats: BASE a disparity map,
+//! UPR a Laplace posterior, ESE a mixture of the M shifted passes, DPP a discrete posterior.
+
+use std::time::Instant;
+
+use burn::prelude::*;
+use lfeval::Bins;
+use lfeval::posterior::{PosteriorForm, PosteriorMap};
+use lfeval::prediction::{ScenePrediction, point_estimates};
+use lfformat::pfm::FloatImage;
+
+use crate::config::{ModelKind, TrainConfig};
+use crate::lightfield::LightField;
+use crate::model::EpiNet;
+use crate::stacks::{Direction, Region, extract};
+use crate::tensors::{tensor4, values};
+
+/// Raw network outputs `[C][H·W]` (channel planes) for `lf` EPI-shifted by `shift`.
+///
+/// `net` must be in validation mode on a device without autodiff (batch norm then uses its
+/// running statistics).
+pub fn run_net(net: &EpiNet, lf: &LightField, shift: f32, device: &Device) -> Vec<Vec<f32>> {
+    let region = Region::whole(lf);
+    let shape = [1, lf.n * 3, lf.height, lf.width];
+    let stacks = Direction::ALL.map(|dir| tensor4(extract(lf, dir, region, shift), shape, device));
+    let out = values(net.forward(stacks));
+    out.chunks_exact(lf.width * lf.height)
+        .map(<[f32]>::to_vec)
+        .collect()
+}
+
+/// The ESE's shifts `s_k = k Δd`, `k = -(M-1)/2 ..= (M-1)/2`.
+pub fn ese_shifts(cfg: &TrainConfig) -> Vec<f32> {
+    let half = (cfg.ese.members / 2) as i32;
+    (-half..=half).map(|k| k as f32 * cfg.ese.delta).collect()
+}
+
+/// The prediction of `net` (trained as `cfg.model`) for `lf`, with its runtime.
+pub fn predict(
+    cfg: &TrainConfig,
+    net: &EpiNet,
+    lf: &LightField,
+    device: &Device,
+) -> ScenePrediction {
+    let start = Instant::now();
+    let (w, h) = (lf.width, lf.height);
+    let posterior = match cfg.model {
+        ModelKind::Base => None,
+        ModelKind::Upr => {
+            let mut out = run_net(net, lf, 0.0, device);
+            let log_b = out.swap_remove(1);
+            let mu = out.swap_remove(0);
+            Some(PosteriorForm::Laplace { mu, log_b })
+        }
+        ModelKind::Ese => Some(ese_mixture(cfg, net, lf, device)),
+        ModelKind::Dpp => Some(dpp_posterior(cfg, run_net(net, lf, 0.0, device))),
+    };
+    let (disparity, posterior) = match posterior {
+        None => {
+            let out = run_net(net, lf, 0.0, device);
+            (FloatImage::new(w, h, out[0].clone()), None)
+        }
+        Some(form) => {
+            let map = PosteriorMap {
+                width: w,
+                height: h,
+                form,
+            };
+            (point_estimates(&map), Some(map))
+        }
+    };
+    ScenePrediction {
+        disparity,
+        uncertainty: None,
+        posterior,
+        runtime_s: Some(start.elapsed().as_secs_f64()),
+    }
+}
+
+/// The ESE mixture (thesis eq. 5.9): pass `k` on the light field shifted by `s_k` predicts
+/// `d - s_k`, so its Laplacian is centred at `μ_k + s_k`; all passes weigh `1/M`.
+fn ese_mixture(cfg: &TrainConfig, net: &EpiNet, lf: &LightField, device: &Device) -> PosteriorForm {
+    let shifts = ese_shifts(cfg);
+    let m = shifts.len();
+    let pixels = lf.width * lf.height;
+    let (mut mu, mut log_b) = (vec![0.0; pixels * m], vec![0.0; pixels * m]);
+    for (k, &s) in shifts.iter().enumerate() {
+        let out = run_net(net, lf, s, device);
+        for i in 0..pixels {
+            mu[i * m + k] = out[0][i] + s;
+            log_b[i * m + k] = out[1][i];
+        }
+    }
+    PosteriorForm::Mixture {
+        components: m,
+        weights: vec![1.0 / m as f32; pixels * m],
+        mu,
+        log_b,
+    }
+}
+
+/// Softmax over the DPP's channel planes, stored per pixel.
+fn dpp_posterior(cfg: &TrainConfig, planes: Vec<Vec<f32>>) -> PosteriorForm {
+    let k = planes.len();
+    let pixels = planes[0].len();
+    let mut probs = vec![0.0; pixels * k];
+    for i in 0..pixels {
+        let max = planes
+            .iter()
+            .map(|p| p[i])
+            .fold(f32::NEG_INFINITY, f32::max);
+        let px = &mut probs[i * k..(i + 1) * k];
+        for (q, p) in px.iter_mut().zip(&planes) {
+            *q = (p[i] - max).exp();
+        }
+        let sum: f32 = px.iter().sum();
+        px.iter_mut().for_each(|q| *q /= sum);
+    }
+    let bins = Bins::new(cfg.dpp.min as f64, cfg.dpp.max as f64, cfg.dpp.bins)
+        .expect("validated DPP bins");
+    PosteriorForm::Discrete { bins, probs }
+}
+
+/// `lftrain predict`: the run's checkpoint applied to every scene of `dataset`, written to
+/// `out` in lfeval's layout (`disp_maps/`, `posteriors/`, `runtimes/`). Returns the scene count.
+pub fn predict_dataset(
+    run: &std::path::Path,
+    dataset: &std::path::Path,
+    out: &std::path::Path,
+    quiet: bool,
+) -> anyhow::Result<usize> {
+    let run = crate::run::RunDir::new(run);
+    let cfg = run.config()?;
+    let state = run.state()?;
+    let device = crate::train::default_device();
+    let net = run.load_net(&cfg, state.grid, &device)?.valid();
+    let scenes = lfeval::dataset::discover(dataset, &[])?;
+    let bar = lfeval::pipeline::progress(scenes.len(), "predicting", quiet);
+    for s in &scenes {
+        let lf = LightField::load(&s.path)?;
+        if lf.n != state.grid {
+            anyhow::bail!(
+                "{}: {}x{} views, the network was trained on {}x{}",
+                s.path.display(),
+                lf.n,
+                lf.n,
+                state.grid,
+                state.grid
+            );
+        }
+        let pred = predict(&cfg, &net, &lf, &device);
+        lfeval::prediction::write_prediction(out, &s.name, &pred)?;
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    Ok(scenes.len())
+}

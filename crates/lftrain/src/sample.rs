@@ -1,0 +1,168 @@
+//! Training samples: a random crop of a scene, rotated, EPI-shifted and colour-augmented, as
+//! the four stacks and the shifted targets; and batches of them in the network's layout.
+
+use rand::{Rng, RngExt};
+
+use crate::augment::Photometric;
+use crate::config::AugmentConfig;
+use crate::lightfield::{crop_plane, rotate_plane};
+use crate::scene::{Scene, Targets};
+use crate::stacks::{Direction, Region, extract};
+
+/// The random choices of one sample, drawn first so that a sample is a pure function of them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Draw {
+    /// Crop origin (left, top) in the scene.
+    pub origin: (usize, usize),
+    /// Quarter turns.
+    pub turns: usize,
+    /// EPI shift, pixels.
+    pub shift: f32,
+    /// Colour, brightness and contrast.
+    pub photometric: Photometric,
+}
+
+impl Draw {
+    /// A random draw for a `patch`-sized crop of a `width × height` scene.
+    pub fn random(
+        cfg: &AugmentConfig,
+        patch: usize,
+        (width, height): (usize, usize),
+        rng: &mut impl Rng,
+    ) -> Self {
+        let mut origin = |size: usize| rng.random_range(0..=size.saturating_sub(patch));
+        let origin = (origin(width), origin(height));
+        let shift = if cfg.max_shift > 0.0 {
+            rng.random_range(-cfg.max_shift..=cfg.max_shift)
+        } else {
+            0.0
+        };
+        Self {
+            origin,
+            turns: if cfg.rotate {
+                rng.random_range(0..4)
+            } else {
+                0
+            },
+            shift,
+            photometric: Photometric::random(cfg, rng),
+        }
+    }
+}
+
+/// One sample: stacks in [`Direction::ALL`] order, each `n * 3` planes of `patch²`, and the
+/// targets as planes `[modes][patch²]` of disparity and of η.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sample {
+    /// The four stacks.
+    pub stacks: [Vec<f32>; 4],
+    /// Target disparities (after the shift).
+    pub disparity: Vec<f32>,
+    /// Target weights.
+    pub eta: Vec<f32>,
+}
+
+/// The sample of `scene` for `draw`.
+///
+/// The crop is taken with a margin wide enough for the EPI shift of the outer views, so the
+/// shifted stacks read real pixels wherever the scene has them, then rotated (views, view grid
+/// and targets together), then the stacks are extracted with the shift.
+pub fn make_sample(scene: &Scene, draw: &Draw, patch: usize) -> Sample {
+    let c = scene.lf.centre() as f32;
+    let margin = (c * draw.shift.abs()).ceil() as usize + 1;
+    let (x0, y0) = (draw.origin.0 as isize, draw.origin.1 as isize);
+    let m = margin as isize;
+    let lf = scene
+        .lf
+        .crop(x0 - m, y0 - m, patch + 2 * margin, patch + 2 * margin)
+        .rotate(draw.turns);
+    let region = Region {
+        x0: margin,
+        y0: margin,
+        width: patch,
+        height: patch,
+    };
+    let stacks = Direction::ALL.map(|dir| {
+        let mut s = extract(&lf, dir, region, draw.shift);
+        draw.photometric.apply(&mut s, patch * patch);
+        s
+    });
+    let (disparity, eta) = target_planes(&scene.targets, (x0, y0), patch, draw);
+    Sample {
+        stacks,
+        disparity,
+        eta,
+    }
+}
+
+/// The targets of the crop, rotated, shifted by `-shift` and split into planes.
+fn target_planes(
+    t: &Targets,
+    origin: (isize, isize),
+    patch: usize,
+    draw: &Draw,
+) -> (Vec<f32>, Vec<f32>) {
+    let ch = t.modes * 2;
+    let mut pairs = crop_plane(&t.pairs, t.width, t.height, ch, origin, (patch, patch));
+    for _ in 0..draw.turns % 4 {
+        pairs = rotate_plane(&pairs, patch, patch, ch);
+    }
+    let plane = patch * patch;
+    let mut disparity = vec![0.0; t.modes * plane];
+    let mut eta = vec![0.0; t.modes * plane];
+    for (i, px) in pairs.chunks_exact(ch).enumerate() {
+        for (j, pair) in px.chunks_exact(2).enumerate() {
+            if pair[1] > 0.0 {
+                disparity[j * plane + i] = pair[0] - draw.shift;
+                eta[j * plane + i] = pair[1];
+            }
+        }
+    }
+    (disparity, eta)
+}
+
+/// A batch in the network's layout: `stacks[k]` is `[batch, n*3, patch, patch]`, targets are
+/// `[batch, modes, patch, patch]`, all flattened row-major.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Batch {
+    /// Samples.
+    pub size: usize,
+    /// Crop side.
+    pub patch: usize,
+    /// Channels per stack.
+    pub stack_channels: usize,
+    /// Target slots per pixel.
+    pub modes: usize,
+    /// The four stacks.
+    pub stacks: [Vec<f32>; 4],
+    /// Target disparities.
+    pub disparity: Vec<f32>,
+    /// Target weights.
+    pub eta: Vec<f32>,
+}
+
+impl Batch {
+    /// Concatenates `samples` (all of the same shape).
+    pub fn from_samples(samples: Vec<Sample>, patch: usize, modes: usize) -> Self {
+        let size = samples.len();
+        let stack_channels = samples[0].stacks[0].len() / (patch * patch);
+        let mut stacks: [Vec<f32>; 4] = Default::default();
+        let (mut disparity, mut eta) = (Vec::new(), Vec::new());
+        for s in samples {
+            for (all, one) in stacks.iter_mut().zip(s.stacks) {
+                all.extend(one);
+            }
+            disparity.extend(s.disparity);
+            eta.extend(s.eta);
+        }
+        Self {
+            size,
+            patch,
+            stack_channels,
+            modes,
+            stacks,
+            disparity,
+            eta,
+        }
+    }
+}

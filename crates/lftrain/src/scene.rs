@@ -1,0 +1,124 @@
+//! One training or validation scene in memory: its star views and its disparity targets.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Result, bail};
+use lfeval::truth::{EtaKind, SceneTruth, eta_of, front};
+
+use crate::lightfield::LightField;
+
+/// Per-pixel disparity targets: `modes` pairs `(d_j, η_j)` per pixel, interleaved
+/// (`(pixel * modes + j) * 2`), row-major, top row first. Unused slots are `(0, 0)` so that
+/// `η · loss` is exactly zero there (a NaN disparity would poison the sum even with `η = 0`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Targets {
+    /// Columns.
+    pub width: usize,
+    /// Rows.
+    pub height: usize,
+    /// Slots per pixel.
+    pub modes: usize,
+    /// `width * height * modes * 2` values.
+    pub pairs: Vec<f32>,
+}
+
+impl Targets {
+    /// Targets of `truth`: the front-most mode with `η = 1` when `modes == 1` (the thesis'
+    /// unimodal truth), else the first `modes` modes front to back with their `η`.
+    pub fn from_truth(truth: &SceneTruth, modes: usize) -> Self {
+        let mut pairs = Vec::with_capacity(truth.width() * truth.height() * modes * 2);
+        for pixel in truth.modes.pixels() {
+            let mut slots = vec![0.0f32; modes * 2];
+            if modes == 1 {
+                if let Some(d) = front(pixel, EtaKind::Over).filter(|d| d.is_finite()) {
+                    slots = vec![d, 1.0];
+                }
+            } else {
+                let valid = pixel
+                    .iter()
+                    .filter(|m| eta_of(m, EtaKind::Over) > 0.0 && m.disparity.is_finite());
+                for (slot, m) in slots.chunks_exact_mut(2).zip(valid) {
+                    slot.copy_from_slice(&[m.disparity, eta_of(m, EtaKind::Over)]);
+                }
+            }
+            pairs.extend_from_slice(&slots);
+        }
+        Self {
+            width: truth.width(),
+            height: truth.height(),
+            modes,
+            pairs,
+        }
+    }
+}
+
+/// A scene ready for sampling.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// Folder name (predictions are named after it).
+    pub name: String,
+    /// Scene folder.
+    pub dir: PathBuf,
+    /// Star views.
+    pub lf: LightField,
+    /// Disparity targets of the centre view.
+    pub targets: Targets,
+}
+
+impl Scene {
+    /// Loads views and ground truth (`modes.exr` if present, else `gt_disp_lowres.pfm`).
+    pub fn load(dir: &Path, name: &str, modes: usize) -> Result<Self> {
+        let lf = LightField::load(dir)?;
+        let truth = SceneTruth::load(dir)?;
+        if (truth.width(), truth.height()) != (lf.width, lf.height) {
+            bail!(
+                "{}: ground truth is {}x{}, the views are {}x{}",
+                dir.display(),
+                truth.width(),
+                truth.height(),
+                lf.width,
+                lf.height
+            );
+        }
+        Ok(Self {
+            name: name.to_string(),
+            dir: dir.to_path_buf(),
+            lf,
+            targets: Targets::from_truth(&truth, modes),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lfformat::pfm::FloatImage;
+    use lfformat::{Mode, ModeMap};
+
+    fn mode(disparity: f32, eta: f32) -> Mode {
+        Mode {
+            disparity,
+            depth: 1.0,
+            eta,
+            eta_exact: eta,
+        }
+    }
+
+    #[test]
+    fn unimodal_targets_take_the_front_mode_and_multimodal_pad_with_zero() {
+        let mut modes = ModeMap::new(2, 1);
+        modes.push_pixel(&[mode(1.5, 0.4), mode(-1.0, 0.6)]);
+        modes.push_pixel(&[]);
+        let truth = SceneTruth {
+            hci: FloatImage::new(2, 1, vec![1.5, f32::NAN]),
+            modes,
+        };
+        let uni = Targets::from_truth(&truth, 1);
+        assert_eq!(uni.pairs, vec![1.5, 1.0, 0.0, 0.0]);
+        let multi = Targets::from_truth(&truth, 3);
+        assert_eq!(
+            multi.pairs,
+            vec![1.5, 0.4, -1.0, 0.6, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+        );
+    }
+}

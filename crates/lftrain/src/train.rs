@@ -1,0 +1,262 @@
+//! The training loop: batches from the [`Loader`], Adam steps, progress, logging, validation
+//! and checkpoints.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
+use burn::prelude::*;
+use indicatif::{ProgressBar, ProgressStyle};
+use lfeval::dataset::discover;
+
+use crate::config::TrainConfig;
+use crate::loader::{Loader, PoolConfig};
+use crate::log::{Record, TrainLog};
+use crate::loss::loss;
+use crate::model::EpiNet;
+use crate::run::{CONFIG_FILE, RunDir, RunState, build_net, grid_of};
+use crate::tensors::{stack_tensors, target_tensors};
+use crate::validate::{ValScene, ValScores, load_scenes, validate};
+
+/// What `lftrain train` was asked to do.
+#[derive(Clone, Debug)]
+pub struct TrainArgs {
+    /// Training dataset (any layout lfeval accepts).
+    pub train: PathBuf,
+    /// Validation dataset.
+    pub val: Option<PathBuf>,
+    /// Run folder.
+    pub out: PathBuf,
+    /// Continue from the run's checkpoint.
+    pub resume: bool,
+    /// No progress bar.
+    pub quiet: bool,
+    /// Loader pool.
+    pub pool: PoolConfig,
+    /// Total steps, overriding the config (also on `--resume`, to extend a finished run).
+    pub steps: Option<usize>,
+}
+
+/// The result of a run.
+#[derive(Clone, Debug)]
+pub struct TrainSummary {
+    /// Every logged step.
+    pub records: Vec<Record>,
+    /// The last validation.
+    pub last_val: Option<ValScores>,
+    /// Mean seconds per optimiser step over this invocation.
+    pub seconds_per_step: f64,
+}
+
+/// The device training runs on: the first enabled backend (wgpu when built with the `wgpu`
+/// feature and a GPU is present, else the flex CPU backend).
+pub fn default_device() -> Device {
+    Device::default()
+}
+
+/// Trains `cfg` (ignored on `--resume`, where the run's stored config is used; only
+/// `args.steps` applies then).
+pub fn train(mut cfg: TrainConfig, args: &TrainArgs) -> Result<TrainSummary> {
+    let run = RunDir::new(&args.out);
+    let (cfg, state) = if args.resume {
+        let mut stored = run.config()?;
+        if let Some(s) = args.steps {
+            stored.steps = s;
+            stored.write(&args.out.join(CONFIG_FILE))?;
+        }
+        (stored, run.state()?)
+    } else {
+        if let Some(s) = args.steps {
+            cfg.steps = s;
+        }
+        if run.has_checkpoint() {
+            bail!(
+                "{}: already holds a run; use --resume or another folder",
+                args.out.display()
+            );
+        }
+        cfg.validate()?;
+        std::fs::create_dir_all(&args.out)
+            .with_context(|| format!("{}: cannot create", args.out.display()))?;
+        cfg.write(&args.out.join(CONFIG_FILE))?;
+        (cfg, RunState::default())
+    };
+    let train_scenes = discover(&args.train, &[])?;
+    let grid = grid_of(&train_scenes)?;
+    let val = match &args.val {
+        Some(v) => load_scenes(&discover(v, &[])?)?,
+        None => Vec::new(),
+    };
+    let base = default_device();
+    let device = base.clone().autodiff();
+    base.seed(cfg.seed);
+    let (net, optim) = if args.resume {
+        let net = run.load_net(&cfg, grid, &device)?;
+        (net, run.load_optimizer(AdamConfig::new().init())?)
+    } else {
+        (build_net(&cfg, grid, &device), AdamConfig::new().init())
+    };
+    let loader = Loader::start(train_scenes, cfg.clone(), args.pool, state.step as u64)?;
+    let mut log = TrainLog::open(&args.out, args.resume, state.step)?;
+    let mut trainer = Trainer {
+        cfg,
+        net,
+        optim,
+        device,
+        base,
+        state: RunState { grid, ..state },
+    };
+    trainer.run(&loader, &val, &mut log, &run, args.quiet)
+}
+
+/// The mutable state of a training run.
+struct Trainer {
+    cfg: TrainConfig,
+    net: EpiNet,
+    optim: ModuleOptimizer,
+    device: Device,
+    base: Device,
+    state: RunState,
+}
+
+impl Trainer {
+    /// Steps until `cfg.steps`.
+    fn run(
+        &mut self,
+        loader: &Loader,
+        val: &[ValScene],
+        log: &mut TrainLog,
+        run: &RunDir,
+        quiet: bool,
+    ) -> Result<TrainSummary> {
+        let bar = progress(self.cfg.steps, self.state.step, quiet);
+        let start = Instant::now();
+        let (first, mut last_val) = (self.state.step, None);
+        while self.state.step < self.cfg.steps {
+            let t0 = Instant::now();
+            let batch = loader.next_batch()?;
+            let loss = self.step(&batch)?;
+            self.state.step += 1;
+            let dt = t0.elapsed().as_secs_f64();
+            self.state.elapsed_s += dt;
+            let step = self.state.step;
+            let mut record = Record {
+                step,
+                loss,
+                samples_per_s: batch.size as f64 / dt,
+                elapsed_s: self.state.elapsed_s,
+                ..Record::default()
+            };
+            let end = step == self.cfg.steps;
+            if !val.is_empty() && (end || every(step, self.cfg.val_every)) {
+                let v = validate(&self.cfg, &self.net.valid(), val, &self.base);
+                record = record.with_val(v);
+                last_val = Some(v);
+                bar.println(format!(
+                    "step {step}: validation MSE×100 {} BadPix(0.07) {} KLD {}",
+                    fmt(v.mse_x100),
+                    fmt(v.badpix_007),
+                    fmt(v.kld)
+                ));
+            }
+            bar.set_message(format!(
+                "loss {loss:.4}  {:.1} samples/s",
+                record.samples_per_s
+            ));
+            bar.inc(1);
+            log.push(record)?;
+            if end || every(step, self.cfg.checkpoint_every) {
+                run.save(&self.net, &self.optim, &self.state)?;
+                log.flush()?;
+            }
+        }
+        bar.finish();
+        let steps = (self.state.step - first).max(1);
+        Ok(TrainSummary {
+            records: log.records.clone(),
+            last_val,
+            seconds_per_step: start.elapsed().as_secs_f64() / steps as f64,
+        })
+    }
+
+    /// One Adam step on `batch`; returns its loss.
+    fn step(&mut self, batch: &crate::sample::Batch) -> Result<f64> {
+        let stacks = stack_tensors(batch, &self.device);
+        let targets = target_tensors(batch, &self.cfg, &self.device);
+        let out = self.net.forward(stacks);
+        let loss = loss(&self.cfg, out, &targets);
+        let value = loss.clone().into_scalar::<f32>() as f64;
+        if !value.is_finite() {
+            bail!("step {}: the loss is {value}", self.state.step + 1);
+        }
+        let grads = GradientsParams::from_grads(loss.backward(), &self.net);
+        let net = self.net.clone();
+        self.net = self.optim.step(self.cfg.learning_rate, net, grads);
+        Ok(value)
+    }
+}
+
+/// Whether `step` is a multiple of a non-zero `period`.
+fn every(step: usize, period: usize) -> bool {
+    period > 0 && step.is_multiple_of(period)
+}
+
+fn fmt(v: Option<f64>) -> String {
+    v.map_or("–".into(), |v| format!("{v:.3}"))
+}
+
+/// The progress bar (hidden with `quiet` or when stderr is not a terminal).
+fn progress(total: usize, done: usize, quiet: bool) -> ProgressBar {
+    let bar = if quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new(total as u64)
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{bar:30} {pos}/{len} steps  {msg}  [{elapsed} < {eta}]")
+            .expect("valid template"),
+    );
+    bar.set_position(done as u64);
+    bar
+}
+
+/// Mean seconds per optimiser step of `cfg`'s network on random `grid × grid` input (no data
+/// loading), after one warm-up step, and the network's parameter count: what `lftrain bench`
+/// reports.
+pub fn bench_steps(cfg: &TrainConfig, grid: usize, steps: usize) -> Result<(f64, usize)> {
+    let base = default_device();
+    let device = base.clone().autodiff();
+    base.seed(cfg.seed);
+    let (p, b, modes) = (cfg.patch, cfg.batch, cfg.target_modes());
+    let noise = |len: usize, scale: f32| -> Vec<f32> {
+        (0..len)
+            .map(|i| ((i.wrapping_mul(2_654_435_761) % 1000) as f32 / 1000.0 - 0.5) * scale)
+            .collect()
+    };
+    let plane = b * p * p;
+    let batch = crate::sample::Batch {
+        size: b,
+        patch: p,
+        stack_channels: grid * 3,
+        modes,
+        stacks: std::array::from_fn(|_| noise(plane * grid * 3, 1.0)),
+        disparity: noise(plane * modes, 6.0),
+        eta: vec![1.0 / modes as f32; plane * modes],
+    };
+    let mut trainer = Trainer {
+        cfg: cfg.clone(),
+        net: build_net(cfg, grid, &device),
+        optim: AdamConfig::new().init(),
+        device,
+        base,
+        state: RunState::default(),
+    };
+    trainer.step(&batch)?;
+    let start = Instant::now();
+    for _ in 0..steps {
+        trainer.step(&batch)?;
+    }
+    let seconds = start.elapsed().as_secs_f64() / steps.max(1) as f64;
+    Ok((seconds, trainer.net.num_params()))
+}
