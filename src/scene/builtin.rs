@@ -61,12 +61,7 @@ pub fn generate(cfg: &Config, index: u64) -> SceneDesc {
         index,
         seed: cfg.dataset.seed,
         camera,
-        slices: SliceRange {
-            z_near: 0.1,
-            z_far: 100.0,
-            count: cfg.render.slices,
-            spacing: cfg.render.slice_spacing,
-        },
+        slices: SliceRange::unframed(&cfg.render),
         environment: s.environment.map(|v| v as f32),
         exposure: cfg.render.exposure as f32,
         materials: g.materials,

@@ -83,6 +83,17 @@ pub struct SliceRange {
 }
 
 impl SliceRange {
+    /// The partition a new scene carries until the renderer frames it (measures its depth
+    /// range); only the count and spacing come from the config.
+    pub fn unframed(render: &crate::config::RenderConfig) -> Self {
+        Self {
+            z_near: 0.1,
+            z_far: 100.0,
+            count: render.slices,
+            spacing: render.slice_spacing,
+        }
+    }
+
     /// Slice of planar depth `z`; depths outside the range go to the first / last slice.
     #[inline]
     pub fn index(&self, z: f32) -> usize {

@@ -64,12 +64,7 @@ fn import_file(path: &Path, cfg: &Config) -> Result<Imported> {
         index: 0,
         seed: cfg.dataset.seed,
         camera,
-        slices: SliceRange {
-            z_near: 0.1,
-            z_far: 100.0,
-            count: cfg.render.slices,
-            spacing: cfg.render.slice_spacing,
-        },
+        slices: SliceRange::unframed(&cfg.render),
         environment: environment.map(|v| v as f32),
         exposure: cfg.render.exposure as f32,
         materials,
