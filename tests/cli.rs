@@ -1,6 +1,9 @@
 //! End-to-end tests of the `lfgen` binary: determinism, resume after a kill, shards, re-render,
 //! the HCI files as other tools read them, and clear errors on bad input.
 
+mod bin;
+
+use bin::{ok, stderr};
 use lfformat::manifest::Manifest;
 use lfformat::pfm::read_pfm;
 use std::collections::BTreeMap;
@@ -24,24 +27,7 @@ const TINY: &[&str] = &[
 ];
 
 fn lfgen(args: &[&str], extra: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_lfgen"))
-        .args(args)
-        .args(extra)
-        .output()
-        .expect("lfgen runs")
-}
-
-fn ok(out: Output) -> Output {
-    assert!(
-        out.status.success(),
-        "lfgen failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
+    bin::lfgen(&[args, extra].concat())
 }
 
 fn tmp() -> tempfile::TempDir {
@@ -104,20 +90,7 @@ fn scene_folder_has_every_hci_and_multimodal_file() {
         .map(|e| e.unwrap().file_name().into_string().unwrap())
         .collect();
     names.sort();
-    let mut expected: Vec<String> = (0..9).map(|i| format!("input_Cam{i:03}.png")).collect();
-    expected.extend(
-        [
-            "gt_depth_lowres.pfm",
-            "gt_disp_lowres.pfm",
-            "gt_mpi_lowres.npz",
-            "modes.exr",
-            "parameters.cfg",
-            "scene.json",
-            "stats.json",
-        ]
-        .map(String::from),
-    );
-    expected.sort();
+    let expected = bin::scene_files(9);
     assert_eq!(names, expected);
     let manifest = Manifest::read(&d.path().join("manifest.json")).unwrap();
     assert_eq!(manifest.scenes.len(), 1);

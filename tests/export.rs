@@ -1,24 +1,10 @@
 //! `lfgen export`: the files each target gets, and clear errors on bad input. (The renderers
 //! themselves are exercised by tests/povray.rs and scripts/validate.sh.)
 
+mod bin;
+
+use bin::{lfgen, ok};
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn lfgen(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_lfgen"))
-        .args(args)
-        .output()
-        .expect("lfgen runs")
-}
-
-fn ok(out: Output) -> Output {
-    assert!(
-        out.status.success(),
-        "lfgen failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
 
 fn scene(dir: &Path) -> String {
     let ds = dir.join("ds");

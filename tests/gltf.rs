@@ -3,6 +3,9 @@
 //! hostile files rejected with errors naming the problem, and the scene folder re-rendered
 //! byte for byte from its scene.json.
 
+mod bin;
+
+use bin::{ok, stderr};
 use glam::{DVec3, Vec3};
 use lfformat::Mode;
 use lfgen::config::{BaselineMode, Config, SliceSpacing};
@@ -13,7 +16,7 @@ use lfgen::scene::gltf::import;
 use lfgen::scene::{Light, SceneDesc, SliceRange, SurfaceModel};
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 use std::sync::atomic::AtomicU64;
 
 fn fixture(name: &str) -> PathBuf {
@@ -459,15 +462,7 @@ const TINY: &[&str] = &[
 ];
 
 fn lfgen(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_lfgen"))
-        .args(args)
-        .args(TINY)
-        .output()
-        .expect("lfgen runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
+    bin::lfgen(&[args, TINY].concat())
 }
 
 fn render(input: &Path, out: &Path, extra: &[&str]) -> Output {
@@ -479,11 +474,6 @@ fn render(input: &Path, out: &Path, extra: &[&str]) -> Output {
     ];
     args.extend_from_slice(extra);
     lfgen(&args)
-}
-
-fn ok(o: Output) -> Output {
-    assert!(o.status.success(), "lfgen failed: {}", stderr(&o));
-    o
 }
 
 fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
@@ -516,21 +506,7 @@ fn rendering_gltf_writes_a_scene_folder_that_scene_json_reproduces() {
     let (first, again) = (tmp.path().join("mask"), tmp.path().join("again"));
     ok(render(&fixture("mask.gltf"), &first, &[]));
     let names: Vec<String> = files(&first).into_iter().map(|(n, _)| n).collect();
-    let mut expected: Vec<String> = (0..9).map(|i| format!("input_Cam{i:03}.png")).collect();
-    expected.extend(
-        [
-            "gt_depth_lowres.pfm",
-            "gt_disp_lowres.pfm",
-            "gt_mpi_lowres.npz",
-            "modes.exr",
-            "parameters.cfg",
-            "scene.json",
-            "stats.json",
-        ]
-        .map(String::from),
-    );
-    expected.sort();
-    assert_eq!(names, expected);
+    assert_eq!(names, bin::scene_files(9));
     // f_px from the camera's yfov (0.5 rad) on the configured 24×20 image, stored HCI-style.
     let cfg = first.join("parameters.cfg");
     let f = ini_value(&cfg, "focal_length_mm") * 24.0 / ini_value(&cfg, "sensor_size_mm");

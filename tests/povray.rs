@@ -14,6 +14,8 @@
 //!
 //! Needs `povray` on the PATH (`.ci/run` installs it); without it the test prints why and passes.
 
+mod bin;
+
 use glam::Vec3;
 use lfformat::pfm::read_pfm;
 use lfgen::render::RenderScene;
@@ -36,15 +38,7 @@ fn povray_available() -> bool {
 }
 
 fn lfgen(args: &[&str]) {
-    let out = Command::new(env!("CARGO_BIN_EXE_lfgen"))
-        .args(args)
-        .output()
-        .expect("lfgen runs");
-    assert!(
-        out.status.success(),
-        "lfgen {args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    bin::ok(bin::lfgen(args));
 }
 
 /// Renders `depth.pov` for one view; `fine` selects the base-256 fine digit.
