@@ -19,6 +19,9 @@ struct IsectTri {
     v0: Vec3A,
     e1: Vec3A,
     e2: Vec3A,
+    /// Unit geometric normal: every path vertex asks for it several times (emission, shading
+    /// frame, ray offsets), and 64 bytes keep one triangle in one cache line.
+    n: Vec3A,
 }
 
 /// Shading data of one triangle, in BVH leaf order.
@@ -92,6 +95,9 @@ impl Geometry {
                 v0: prims[i].v0,
                 e1: prims[i].v1 - prims[i].v0,
                 e2: prims[i].v2 - prims[i].v0,
+                n: (prims[i].v1 - prims[i].v0)
+                    .cross(prims[i].v2 - prims[i].v0)
+                    .normalize_or_zero(),
             })
             .collect();
         let shading: Vec<TriShading> = order
@@ -157,8 +163,7 @@ impl Geometry {
     /// Geometric (winding) normal, unit length.
     #[inline]
     pub fn geometric_normal(&self, tri: u32) -> Vec3 {
-        let t = &self.isect[tri as usize];
-        Vec3::from(t.e1.cross(t.e2)).normalize()
+        Vec3::from(self.isect[tri as usize].n)
     }
 
     /// Interpolated shading normal.
