@@ -6,7 +6,7 @@ use super::geometry::Hit;
 use super::integrator::PathSettings;
 use super::sampler::Sampler;
 use super::slices::{SliceAccumulator, SliceHit};
-use crate::camera::{LightFieldCamera, ViewRays};
+use crate::camera::{CameraRay, LightFieldCamera, ViewRays};
 use crate::scene::SliceRange;
 use glam::Vec3;
 use lfformat::{Mode, ModeMap};
@@ -114,6 +114,7 @@ impl RenderScene {
                                 view,
                                 x,
                                 y,
+                                centre: rays.ray(x as f32 + 0.5, y as f32 + 0.5),
                             };
                             ctx.render(with_gt, scratch, &mut band);
                         }
@@ -167,6 +168,8 @@ struct PixelCtx<'a> {
     view: u32,
     x: u32,
     y: u32,
+    /// The ray through the pixel centre (HCI depth, slice snapping), computed once per pixel.
+    centre: CameraRay,
 }
 
 impl PixelCtx<'_> {
@@ -174,7 +177,7 @@ impl PixelCtx<'_> {
         let s = self.settings;
         let mut sampler = Sampler::new(s.seed, s.scene_index, self.view, self.x, self.y, s.spp);
         let mut sum = Vec3::ZERO;
-        let centre = self.rays.ray(self.x as f32 + 0.5, self.y as f32 + 0.5);
+        let centre = self.centre;
         if with_gt {
             let geo = &self.scene.geometry;
             geo.all_hits(
@@ -229,7 +232,7 @@ impl PixelCtx<'_> {
         sampler: &mut Sampler,
         scratch: &mut Scratch,
     ) -> Vec3 {
-        let centre = self.rays.ray(self.x as f32 + 0.5, self.y as f32 + 0.5);
+        let centre = self.centre;
         let (scene, geo, mats) = (self.scene, &self.scene.geometry, &self.scene.materials);
         let centre_hits = &scratch.centre_hits;
         geo.all_hits(origin, dir, f32::INFINITY, &mut scratch.hits);
