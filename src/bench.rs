@@ -15,7 +15,7 @@ const BENCH_RES: u32 = 192;
 pub fn run(cfg: &Config) -> Result<()> {
     let mut cfg = cfg.clone();
     cfg.camera.resolution = [BENCH_RES, BENCH_RES];
-    let (desc, scene) = generate_scene(&cfg, 0)?;
+    let (desc, scene) = generate_scene(&cfg, 0, None)?;
     let cam = &desc.camera;
     println!(
         "scene: {} triangles, {} threads, {}x{} px, {} spp, max depth {}",

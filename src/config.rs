@@ -200,6 +200,13 @@ pub struct SceneConfig {
     pub lights: u32,
     /// Radiance of the environment seen through openings (linear RGB).
     pub environment: [f64; 3],
+    /// Asset catalogue (`catalog.json`) to draw pieces from besides the procedural furniture;
+    /// empty: procedural only.
+    pub catalog: String,
+    /// With a catalogue: the share of pieces drawn from it (the rest are procedural).
+    pub catalog_share: f64,
+    /// Weights of catalogue categories (absent ones weigh 1), times each entry's own weight.
+    pub category_weights: std::collections::BTreeMap<String, f64>,
 }
 
 impl Default for SceneConfig {
@@ -217,6 +224,9 @@ impl Default for SceneConfig {
             texture_seed: 0,
             lights: 4,
             environment: [0.2, 0.22, 0.25],
+            catalog: String::new(),
+            catalog_share: 0.5,
+            category_weights: std::collections::BTreeMap::new(),
         }
     }
 }
@@ -383,6 +393,14 @@ impl SceneConfig {
         let probs = [self.semi_transparent, self.glass, self.cutout];
         if probs.iter().any(|p| !(0.0..=1.0).contains(p)) || self.opacity_range[1] > 1.0 {
             bail!("scene probabilities and opacities must lie in [0, 1]");
+        }
+        if !(0.0..=1.0).contains(&self.catalog_share) {
+            bail!("scene.catalog_share must lie in [0, 1]");
+        }
+        if let Some((c, w)) =
+            (self.category_weights.iter()).find(|(_, w)| !(w.is_finite() && **w >= 0.0))
+        {
+            bail!("scene.category_weights: {c:?} has weight {w}, expected a number >= 0");
         }
         Ok(())
     }

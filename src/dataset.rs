@@ -6,6 +6,7 @@
 
 use crate::config::Config;
 use crate::pipeline::{RenderJob, generate_scene, render_scene};
+use crate::scene::library::AssetLibrary;
 use crate::stats::{DatasetSummary, SceneStats};
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -26,6 +27,8 @@ pub struct GenerateOptions {
     pub shard: (u64, u64),
     pub resume: bool,
     pub quiet: bool,
+    /// A broken asset-catalogue entry is an error instead of a skipped entry.
+    pub strict: bool,
 }
 
 /// Split of scene `index` (see `dataset.val_every`).
@@ -65,6 +68,7 @@ pub fn generate(cfg: &Config, opts: &GenerateOptions) -> Result<()> {
         cfg.dataset.date.clone()
     };
     let job = RenderJob::from_config(cfg, &date);
+    let library = open_library(cfg, opts.strict)?;
     let [w, h] = cfg.camera.resolution;
     let per_scene = w as u64
         * h as u64
@@ -86,8 +90,8 @@ pub fn generate(cfg: &Config, opts: &GenerateOptions) -> Result<()> {
             continue;
         }
         let started = Instant::now();
-        let (mut desc, scene) =
-            generate_scene(cfg, index).with_context(|| format!("scene {index}"))?;
+        let (mut desc, scene) = generate_scene(cfg, index, library.as_ref())
+            .with_context(|| format!("scene {index}"))?;
         let before = samples.load(Ordering::Relaxed);
         let files = std::thread::scope(|s| {
             let ticker = s.spawn(|| tick(&bar, &samples, before + per_scene));
@@ -125,6 +129,27 @@ pub fn generate(cfg: &Config, opts: &GenerateOptions) -> Result<()> {
         write_readme(&opts.out, &manifest)?;
     }
     Ok(())
+}
+
+/// The asset library of `scene.catalog`, checked once; each skipped entry is reported on one
+/// warning line.
+fn open_library(cfg: &Config, strict: bool) -> Result<Option<AssetLibrary>> {
+    if cfg.scene.catalog.is_empty() {
+        return Ok(None);
+    }
+    let path = Path::new(&cfg.scene.catalog);
+    eprintln!("checking the asset catalogue {} …", path.display());
+    let library = AssetLibrary::open(path, strict)?;
+    for line in &library.skipped {
+        eprintln!("warning: {}: skipped {line}", path.display());
+    }
+    eprintln!(
+        "{}: {} assets usable, {} skipped",
+        path.display(),
+        library.len(),
+        library.skipped.len()
+    );
+    Ok(Some(library))
 }
 
 /// Keeps the progress bar moving while a scene renders; stops when `end` samples are done.

@@ -6,6 +6,7 @@
 
 pub mod bench;
 pub mod camera;
+pub mod catalog;
 pub mod config;
 pub mod dataset;
 pub mod export;

@@ -86,6 +86,10 @@ struct GenerateArgs {
     /// Keep scenes whose files verify against the manifest, redo the rest.
     #[arg(long)]
     resume: bool,
+    /// A broken or hostile asset-catalogue entry (scene.catalog) is an error instead of a
+    /// skipped entry with a warning.
+    #[arg(long)]
+    strict: bool,
     #[command(flatten)]
     common: ConfigArgs,
 }
@@ -214,6 +218,7 @@ fn generate(a: GenerateArgs) -> Result<()> {
         shard,
         resume: a.resume,
         quiet: a.common.quiet,
+        strict: a.strict,
     };
     dataset::generate(&cfg, &opts)?;
     eprintln!("dataset written to {}", opts.out.display());

@@ -8,6 +8,7 @@ use crate::render::framing::auto_exposure;
 use crate::render::integrator::PathSettings;
 use crate::render::view::{RenderSettings, ViewOutput};
 use crate::scene::assets::Assets;
+use crate::scene::library::AssetLibrary;
 use crate::scene::{SceneDesc, builtin};
 use crate::stats::SceneStats;
 use anyhow::{Context, Result, bail};
@@ -66,10 +67,16 @@ impl RenderJob {
     }
 }
 
-/// Generates scene `index` of `cfg` and frames its camera: the re-renderable description.
-pub fn generate_scene(cfg: &Config, index: u64) -> Result<(SceneDesc, RenderScene)> {
-    let mut desc = builtin::generate(cfg, index);
-    let scene = RenderScene::build(&desc)?;
+/// Generates scene `index` of `cfg` (drawing catalogue pieces from `library`, if any) and
+/// frames its camera: the re-renderable description.
+pub fn generate_scene(
+    cfg: &Config,
+    index: u64,
+    library: Option<&AssetLibrary>,
+) -> Result<(SceneDesc, RenderScene)> {
+    let mut desc = builtin::generate(cfg, index, library);
+    let assets = Assets::load(&desc)?;
+    let scene = RenderScene::build_with(&desc, &assets)?;
     desc.slices = scene.frame(
         &mut desc.camera,
         &cfg.camera,

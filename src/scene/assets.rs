@@ -1,11 +1,12 @@
 //! The data a scene description refers to instead of holding: triangles of glTF mesh
-//! primitives (in mesh space) and decoded texture images, loaded once per scene and shared by
-//! every object and material that uses them.
+//! primitives and OBJ meshes (in mesh space) and decoded texture images, loaded once per scene
+//! and shared by every object and material that uses them.
 
 use super::gltf::GltfFile;
+use super::obj::ObjFile;
 use super::shapes::MeshTri;
 use super::texture_image::{ImageMap, TextureImage};
-use super::{Material, Opacity, SceneDesc, Shape, Texture};
+use super::{Material, Opacity, SceneDesc, Shape, SourceFile, Texture};
 use anyhow::{Context, Result};
 use std::collections::BTreeMap;
 use std::collections::btree_map::Entry;
@@ -52,17 +53,17 @@ impl Assets {
     /// Opens every source file of `desc` — refusing one that changed since the scene was
     /// written — and loads what the scene refers to.
     pub fn load(desc: &SceneDesc) -> Result<Self> {
-        let files: Vec<GltfFile> = desc
+        let files: Vec<Source> = desc
             .sources
             .iter()
-            .map(GltfFile::open_unchanged)
+            .map(Source::open_unchanged)
             .collect::<Result<_>>()?;
         Self::from_files(desc, &files)
     }
 
     /// Loads what `desc` refers to from its already opened source files (`files[i]` is source
     /// `i`).
-    pub fn from_files(desc: &SceneDesc, files: &[GltfFile]) -> Result<Self> {
+    pub fn from_files(desc: &SceneDesc, files: &[Source]) -> Result<Self> {
         let file = |source: u32| {
             files
                 .get(source as usize)
@@ -72,7 +73,7 @@ impl Assets {
         for key in desc.objects.iter().filter_map(|o| MeshKey::of(&o.shape)) {
             if let Entry::Vacant(slot) = assets.meshes.entry(key) {
                 let file = file(key.source)?;
-                slot.insert(file.primitive_triangles(key.mesh, key.primitive, key.uv_set)?);
+                slot.insert(file.primitive_triangles(key)?);
             }
         }
         for map in desc.materials.iter().flat_map(image_maps) {
@@ -103,6 +104,45 @@ impl Assets {
                     map.image, map.source
                 )
             })
+    }
+}
+
+/// An opened source file of either format.
+pub enum Source {
+    Gltf(GltfFile),
+    Obj(ObjFile),
+}
+
+impl Source {
+    /// Opens a saved scene's source by its file extension, refusing it if anything changed.
+    pub fn open_unchanged(src: &SourceFile) -> Result<Self> {
+        match src.path.to_ascii_lowercase().ends_with(".obj") {
+            true => ObjFile::open_unchanged(src).map(Source::Obj),
+            false => GltfFile::open_unchanged(src).map(Source::Gltf),
+        }
+    }
+
+    /// Mesh-space triangles of a mesh (an OBJ has one primitive and one UV set per mesh).
+    fn primitive_triangles(&self, key: MeshKey) -> Result<Vec<MeshTri>> {
+        match self {
+            Source::Gltf(f) => f.primitive_triangles(key.mesh, key.primitive, key.uv_set),
+            Source::Obj(f) => f.mesh_triangles(key.mesh),
+        }
+    }
+
+    /// The description for `scene.json`, with every file read so far.
+    pub fn source_file(&self) -> Result<SourceFile> {
+        match self {
+            Source::Gltf(f) => f.source_file(),
+            Source::Obj(f) => f.source_file(),
+        }
+    }
+
+    fn texture_image(&self, image: u32) -> Result<TextureImage> {
+        match self {
+            Source::Gltf(f) => f.texture_image(image),
+            Source::Obj(f) => f.texture_image(image),
+        }
     }
 }
 

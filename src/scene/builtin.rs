@@ -8,9 +8,11 @@
 //! function of the config.
 
 use super::furniture::{self, Kind, MaterialSource, Piece, Placement, Role};
+use super::library::AssetLibrary;
 use super::placement::{Body, Footprint, Layer, Layout, PlacementReport, WorldSurface};
 use super::{
-    Material, Object, Opacity, SceneDesc, Shape, SliceRange, SurfaceModel, Texture, Transform,
+    Material, Object, Opacity, SceneDesc, Shape, SliceRange, SourceFile, SurfaceModel, Texture,
+    Transform,
 };
 use crate::camera::LightFieldCamera;
 use crate::config::Config;
@@ -38,12 +40,14 @@ const SKIRTING: [f32; 2] = [0.08, 0.015];
 
 /// Generates scene `index` of the dataset described by `cfg`. The camera's baseline, focus and
 /// the slice range are provisional until the renderer frames the scene.
-pub fn generate(cfg: &Config, index: u64) -> SceneDesc {
+pub fn generate(cfg: &Config, index: u64, library: Option<&AssetLibrary>) -> SceneDesc {
     let mut g = Gen {
         rng: Pcg32::new(mix64(cfg.dataset.seed ^ mix64(index)), 0x5CE7E),
         cfg,
+        library,
         materials: Vec::new(),
         objects: Vec::new(),
+        sources: Vec::new(),
     };
     let s = &cfg.scene;
     let size = Vec3::new(
@@ -68,15 +72,26 @@ pub fn generate(cfg: &Config, index: u64) -> SceneDesc {
         objects: g.objects,
         lights: Vec::new(),
         placement: Some(report),
-        sources: Vec::new(),
+        sources: g.sources,
     }
 }
 
 struct Gen<'a> {
     rng: Pcg32,
     cfg: &'a Config,
+    library: Option<&'a AssetLibrary>,
     materials: Vec<Material>,
     objects: Vec<Object>,
+    /// Model files of the catalogue pieces placed so far.
+    sources: Vec<SourceFile>,
+}
+
+/// What a furniture slot of a scene is filled with.
+#[derive(Clone, Copy, Debug)]
+enum Pick {
+    Kind(Kind),
+    /// Entry of the asset library.
+    Asset(usize),
 }
 
 /// Resolves the roles of one piece to materials, one material per role.
@@ -248,20 +263,28 @@ impl Gen<'_> {
                 (self.library(&all), 0.6, 0.0)
             }
         };
+        let mut m = self.standard(&name, texture, roughness, Opacity::constant(1.0));
+        m.metallic = metallic;
+        self.randomised(m)
+    }
+
+    /// Adds the solid material `m`, made glass, a grid cut-out or semi-transparent by the
+    /// scene's shares. Materials that already see through, or glow, are kept as they are.
+    fn randomised(&mut self, mut m: Material) -> u32 {
+        if m.opacity.uniform() != Some(1.0) || m.is_emissive() || m.model != SurfaceModel::Standard
+        {
+            return self.push_material(m);
+        }
         let s = &self.cfg.scene;
         let (glass, semi, cutout, range) = (s.glass, s.semi_transparent, s.cutout, s.opacity_range);
         if self.chance(glass) {
-            return self.glass(&name);
+            return self.glass(&m.name);
         }
-        let opacity = if self.chance(cutout) {
-            self.grid()
+        if self.chance(cutout) {
+            m.opacity = self.grid();
         } else if self.chance(semi) {
-            Opacity::constant(self.range(range))
-        } else {
-            Opacity::constant(1.0)
-        };
-        let mut m = self.standard(&name, texture, roughness, opacity);
-        m.metallic = metallic;
+            m.opacity = Opacity::constant(self.range(range));
+        }
         self.push_material(m)
     }
 
@@ -500,55 +523,100 @@ impl Gen<'_> {
         }
     }
 
-    /// Draws `scene.objects` pieces by kind weight and places them: floor and wall pieces
-    /// first, then accessories on their surfaces.
+    /// Draws `scene.objects` pieces — by kind weight, and with an asset library a share of
+    /// them by catalogue weight — and places them: floor and wall pieces first, then
+    /// accessories on their surfaces.
     fn furnish(&mut self, room: Vec3, cam: &LightFieldCamera) -> PlacementReport {
-        let total: f32 = Kind::ALL.iter().map(|k| k.weight()).sum();
-        let mut kinds: Vec<Kind> = (0..self.cfg.scene.objects)
-            .map(|_| {
-                let mut t = self.unit() * total;
-                *Kind::ALL
-                    .iter()
-                    .find(|k| {
-                        t -= k.weight();
-                        t < 0.0
-                    })
-                    .unwrap_or(&Kind::Crate)
-            })
-            .collect();
-        kinds.sort_by_key(|k| k.placement() == Placement::OnTop);
+        let mut picks: Vec<Pick> = (0..self.cfg.scene.objects).map(|_| self.pick()).collect();
+        picks.sort_by_key(|&p| self.placement_of(p) == Placement::OnTop);
         let view = View::of(cam, room);
         let mut layout = Layout::new(room);
         let mut report = PlacementReport {
-            requested: kinds.len() as u32,
+            requested: picks.len() as u32,
             ..PlacementReport::default()
         };
-        for (i, kind) in kinds.into_iter().enumerate() {
-            let (materials, objects) = (self.materials.len(), self.objects.len());
-            let name = format!("object_{i}_{kind:?}").to_lowercase();
-            let piece = {
+        for (i, pick) in picks.into_iter().enumerate() {
+            let before = (self.materials.len(), self.objects.len(), self.sources.len());
+            let (name, piece) = self.build(i, pick);
+            match self.place(&piece, &mut layout, &view) {
+                Some(xf) => {
+                    report.placed += 1;
+                    report.on_top += (piece.placement == Placement::OnTop) as u32;
+                    report.from_catalog += matches!(pick, Pick::Asset(_)) as u32;
+                    self.emit(&name, &piece, &xf);
+                }
+                None => {
+                    report.rejected += 1;
+                    self.materials.truncate(before.0);
+                    self.objects.truncate(before.1);
+                    self.sources.truncate(before.2);
+                }
+            }
+        }
+        report
+    }
+
+    /// Draws what fills one furniture slot. Without a library the draws are exactly those of
+    /// the procedural generator alone.
+    fn pick(&mut self) -> Pick {
+        if let Some(lib) = self.library
+            && self.chance(self.cfg.scene.catalog_share)
+        {
+            let weights = lib.weights(&self.cfg.scene.category_weights);
+            return Pick::Asset(self.weighted(&weights).unwrap_or(0));
+        }
+        let weights: Vec<f32> = Kind::ALL.iter().map(|k| k.weight()).collect();
+        Pick::Kind(Kind::ALL[self.weighted(&weights).unwrap_or(Kind::ALL.len() - 1)])
+    }
+
+    /// An index drawn with probability proportional to `weights` (`None`: all zero).
+    fn weighted(&mut self, weights: &[f32]) -> Option<usize> {
+        let mut t = self.unit() * weights.iter().sum::<f32>();
+        weights.iter().position(|w| {
+            t -= w;
+            t < 0.0
+        })
+    }
+
+    fn placement_of(&self, pick: Pick) -> Placement {
+        match (pick, self.library) {
+            (Pick::Kind(k), _) => k.placement(),
+            (Pick::Asset(i), Some(lib)) => lib.piece_placement(i),
+            (Pick::Asset(_), None) => unreachable!("assets are drawn from a library"),
+        }
+    }
+
+    /// Builds the piece of slot `i` with its own RNG stream and materials.
+    fn build(&mut self, i: usize, pick: Pick) -> (String, Piece) {
+        let mut rng = Pcg32::new(self.rng.random(), 0xF0_0D);
+        match pick {
+            Pick::Kind(kind) => {
+                let name = format!("object_{i}_{kind:?}").to_lowercase();
                 let mut mats = PieceMaterials {
                     owner: self,
                     name: name.clone(),
                     by_role: BTreeMap::new(),
                 };
-                let mut rng = Pcg32::new(mats.owner.rng.random(), 0xF0_0D);
-                furniture::build(kind, &mut rng, &mut mats)
-            };
-            match self.place(&piece, &mut layout, &view) {
-                Some(xf) => {
-                    report.placed += 1;
-                    report.on_top += (kind.placement() == Placement::OnTop) as u32;
-                    self.emit(&name, &piece, &xf);
-                }
-                None => {
-                    report.rejected += 1;
-                    self.materials.truncate(materials);
-                    self.objects.truncate(objects);
-                }
+                (name, furniture::build(kind, &mut rng, &mut mats))
+            }
+            Pick::Asset(a) => {
+                let lib = self.library.expect("assets are drawn from a library");
+                let name = format!("object_{i}_{}", identifier(&lib.asset(a).id));
+                let file = lib.source(a);
+                let source = match self.sources.iter().position(|s| s.path == file.path) {
+                    Some(s) => s,
+                    None => {
+                        self.sources.push(file.clone());
+                        self.sources.len() - 1
+                    }
+                };
+                let piece = lib.piece(a, source as u32, &mut |mut m| {
+                    m.name = format!("{name}_{}", m.name);
+                    self.randomised(m)
+                });
+                (name, piece)
             }
         }
-        report
     }
 
     /// Adds the parts of `piece` placed by `at` (yaw and floor position).
@@ -572,11 +640,15 @@ impl Gen<'_> {
     /// placement, or `None` after [`TRIES`] attempts.
     fn place(&mut self, piece: &Piece, layout: &mut Layout, view: &View) -> Option<Transform> {
         for _ in 0..TRIES {
-            let candidate = match piece.kind.placement() {
+            let candidate = match piece.placement {
                 Placement::OnTop => self.on_top_spot(piece, layout),
                 Placement::Wall | Placement::WallHung => self.wall_spot(piece, layout.room, view),
                 Placement::Floor if self.chance(0.25) => self.wall_spot(piece, layout.room, view),
                 Placement::Floor | Placement::FloorCover => Some(self.floor_spot(piece, view)),
+                Placement::Ceiling => {
+                    let (fp, _, host) = self.floor_spot(piece, view);
+                    Some((fp, layout.room.y - piece.height, host))
+                }
             };
             let Some((footprint, base, host)) = candidate else {
                 continue;
@@ -584,7 +656,7 @@ impl Gen<'_> {
             let body = Body {
                 footprint,
                 y: [base + piece.elevation, base + piece.height],
-                layer: match piece.kind.placement() {
+                layer: match piece.placement {
                     Placement::FloorCover => Layer::Cover,
                     _ => Layer::Solid,
                 },
@@ -593,7 +665,7 @@ impl Gen<'_> {
                 continue;
             }
             let index = layout.add(body);
-            if piece.kind.placement() != Placement::OnTop {
+            if piece.placement != Placement::OnTop {
                 for s in &piece.surfaces {
                     let area = Footprint {
                         centre: footprint.to_world(s.centre),
@@ -641,7 +713,7 @@ impl Gen<'_> {
         view: &View,
     ) -> Option<(Footprint, f32, Option<usize>)> {
         // Pictures hang flush on the wall; standing pieces clear the skirting.
-        let off = match piece.kind.placement() {
+        let off = match piece.placement {
             Placement::WallHung => piece.half.y,
             _ => SKIRTING[1] + 0.005 + piece.half.y,
         };
@@ -693,6 +765,16 @@ impl Gen<'_> {
         };
         s.area.contains(&fp).then_some((fp, s.y, Some(s.host)))
     }
+}
+
+/// A catalogue id as part of an object name: letters and digits, the rest `_`.
+fn identifier(id: &str) -> String {
+    id.chars()
+        .map(|c| match c.is_ascii_alphanumeric() {
+            true => c.to_ascii_lowercase(),
+            false => '_',
+        })
+        .collect()
 }
 
 /// The part of the floor the centre camera sees: a wedge from the camera along −Z, widened
@@ -765,8 +847,10 @@ mod tests {
             let mut g = Gen {
                 rng: Pcg32::new(mix64(seed), 1),
                 cfg: &c,
+                library: None,
                 materials: Vec::new(),
                 objects: Vec::new(),
+                sources: Vec::new(),
             };
             let room = Vec3::new(
                 g.range(c.scene.room_width),
@@ -808,9 +892,9 @@ mod tests {
     #[test]
     fn scenes_are_deterministic_per_seed_and_index_and_report_placement() {
         let c = cfg(5);
-        let a = generate(&c, 3);
-        assert_eq!(a, generate(&c, 3));
-        assert_ne!(a, generate(&c, 4));
+        let a = generate(&c, 3, None);
+        assert_eq!(a, generate(&c, 3, None));
+        assert_ne!(a, generate(&c, 4, None));
         let r = a.placement.clone().unwrap();
         assert_eq!(r.requested, c.scene.objects);
         assert_eq!(r.placed + r.rejected, r.requested);
@@ -836,7 +920,7 @@ mod tests {
         use crate::scene::assets::Assets;
         use crate::scene::shapes::tessellate;
         for seed in 0..12 {
-            let desc = generate(&cfg(seed), seed);
+            let desc = generate(&cfg(seed), seed, None);
             let room = desc
                 .objects
                 .iter()

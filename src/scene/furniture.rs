@@ -60,6 +60,8 @@ pub enum Placement {
     OnTop,
     /// Flat on the floor; others may stand on it (rugs).
     FloorCover,
+    /// Hanging from the ceiling, its top against it (catalogue pendant lamps).
+    Ceiling,
 }
 
 /// A horizontal rectangle others can stand on, in the piece's frame.
@@ -84,7 +86,7 @@ pub struct Part {
 /// A generated piece of furniture or accessory.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Piece {
-    pub kind: Kind,
+    pub placement: Placement,
     pub parts: Vec<Part>,
     /// Footprint half extents along X and Z around the origin.
     pub half: Vec2,
@@ -304,7 +306,7 @@ pub fn build(kind: Kind, rng: &mut Pcg32, mats: &mut dyn MaterialSource) -> Piec
         Kind::BookStack => book_stack(&mut d, &mut b),
     };
     Piece {
-        kind,
+        placement: kind.placement(),
         parts: b.parts,
         half,
         height,

@@ -9,10 +9,13 @@
 
 pub mod assets;
 pub mod builtin;
+pub mod files;
 pub mod furniture;
 pub mod gltf;
+pub mod library;
 pub mod light;
 pub mod material;
+pub mod obj;
 pub mod placement;
 pub mod shapes;
 pub mod texture_image;
@@ -57,13 +60,18 @@ pub struct SceneDesc {
 /// notices when it changed.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SourceFile {
-    /// Absolute path of the glTF or GLB file.
+    /// Absolute path of the glTF, GLB or OBJ file.
     pub path: String,
     /// SHA-256 of that file (lowercase hex).
     pub sha256: String,
-    /// External files it references that were read (buffers, images), by their URI.
+    /// External files it references that were read (buffers, images, material libraries), by
+    /// their URI (glTF: relative to the file's folder; OBJ: relative to `root`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub resources: Vec<Resource>,
+    /// OBJ files: the folder their material libraries and textures may be read from (the
+    /// asset catalogue's folder).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub root: Option<String>,
 }
 
 /// An external file referenced by a glTF, by its URI relative to the glTF's folder.

@@ -129,6 +129,13 @@ pub struct PlacementReport {
     pub rejected: u32,
     /// Of the placed, how many stand on another piece.
     pub on_top: u32,
+    /// Of the placed, how many come from the asset catalogue (`scene.catalog`).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub from_catalog: u32,
+}
+
+fn is_zero(n: &u32) -> bool {
+    *n == 0
 }
 
 impl Layout {

@@ -76,17 +76,17 @@ pub struct TextureImage {
 }
 
 /// sRGB-encoded 8-bit value → linear, for all 256 codes.
-static SRGB_TO_LINEAR: LazyLock<[f32; 256]> = LazyLock::new(|| {
-    std::array::from_fn(|i| {
-        let c = i as f32 / 255.0;
-        if c <= 0.04045 {
-            c / 12.92
-        } else {
-            ((c + 0.055) / 1.055).powf(2.4)
-        }
-    })
-});
+static SRGB_TO_LINEAR: LazyLock<[f32; 256]> =
+    LazyLock::new(|| std::array::from_fn(|i| srgb_to_linear(i as f32 / 255.0)));
 
+/// The sRGB transfer function inverted: an encoded value in [0, 1] → linear.
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
 /// Size only: materials that hold an image are printed without millions of texels.
 impl std::fmt::Debug for TextureImage {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -141,6 +141,16 @@ impl TextureImage {
 
     pub fn is_opaque(&self) -> bool {
         self.opaque
+    }
+
+    /// The image with each texel's red level (a grey image's value) as its alpha: scalar
+    /// opacity maps (OBJ's `map_d`) carry coverage in their colour.
+    pub fn grey_as_alpha(mut self) -> Self {
+        for t in &mut self.texels {
+            t[3] = t[0];
+        }
+        self.opaque = self.texels.iter().all(|t| t[3] == 255);
+        self
     }
 
     /// Linear RGB (decoded from sRGB) and linear alpha of texel `(x, y)`.

@@ -16,7 +16,7 @@ mod source;
 
 pub use source::GltfFile;
 
-use super::assets::Assets;
+use super::assets::{Assets, Source};
 use super::{Material, SceneDesc, SliceRange};
 use crate::config::Config;
 use anyhow::{Context, Result};
@@ -73,9 +73,10 @@ fn import_file(path: &Path, cfg: &Config) -> Result<Imported> {
         placement: None,
         sources: Vec::new(),
     };
-    let assets = Assets::from_files(&desc, std::slice::from_ref(&file))?;
+    let file = [Source::Gltf(file)];
+    let assets = Assets::from_files(&desc, &file)?;
     // After loading, so the checksums of every file read are recorded.
-    desc.sources = vec![file.source_file()?];
+    desc.sources = vec![file[0].source_file()?];
     Ok(Imported {
         desc,
         assets,

@@ -3,6 +3,7 @@
 //! name a file beside the glTF (or below its folder) or be a base64 `data:` URI of bounded size.
 
 use crate::output::hex_sha256;
+use crate::scene::files::{read_limited, resolve_inside};
 use crate::scene::texture_image::TextureImage;
 use crate::scene::{Resource, SourceFile};
 use ::gltf::buffer::View;
@@ -13,8 +14,6 @@ use std::cell::RefCell;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// Largest file (glTF, GLB, buffer or image) that is read.
-const MAX_FILE_BYTES: u64 = 2 << 30;
 /// Largest decoded `data:` URI.
 const MAX_DATA_URI_BYTES: usize = 512 << 20;
 
@@ -114,6 +113,7 @@ impl GltfFile {
                     sha256: sha256.clone(),
                 })
                 .collect(),
+            root: None,
         })
     }
 
@@ -207,20 +207,6 @@ impl GltfFile {
         let path = local_path(&self.dir, uri).with_context(|| format!("uri {uri:?}"))?;
         Ok(hex_sha256(&read_limited(&path)?))
     }
-}
-
-/// Reads a whole file after checking its size.
-fn read_limited(path: &Path) -> Result<Vec<u8>> {
-    let len = std::fs::metadata(path)
-        .with_context(|| format!("cannot read {}", path.display()))?
-        .len();
-    ensure!(
-        len <= MAX_FILE_BYTES,
-        "{} is {len} bytes, more than the {} GiB lfgen reads",
-        path.display(),
-        MAX_FILE_BYTES >> 30
-    );
-    std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))
 }
 
 /// GLB: magic, version 2 and a total length that fits the file. (The crate subtracts the
@@ -331,29 +317,7 @@ fn local_path(dir: &Path, uri: &str) -> Result<PathBuf> {
             &uri[..=c]
         );
     }
-    let decoded = percent_decode(uri)?;
-    ensure!(!decoded.is_empty(), "the URI is empty");
-    ensure!(
-        !decoded.starts_with(['/', '\\']),
-        "absolute paths are not read, only files beside the glTF"
-    );
-    let mut path = dir.to_path_buf();
-    for part in decoded.split(['/', '\\']) {
-        match part {
-            "" | "." => {}
-            ".." => bail!("\"..\" would leave the glTF's folder: only files beside it are read"),
-            _ => path.push(part),
-        }
-    }
-    let resolved = path
-        .canonicalize()
-        .with_context(|| format!("cannot open {}", path.display()))?;
-    ensure!(
-        resolved.starts_with(dir),
-        "{} leads outside the glTF's folder (a symbolic link?)",
-        path.display()
-    );
-    Ok(resolved)
+    resolve_inside(dir, dir, &percent_decode(uri)?, "the glTF's")
 }
 
 /// `%XX` escapes of a URI decoded (glTF URIs are RFC 3986 references).
