@@ -200,6 +200,12 @@ pub struct SceneConfig {
     pub lights: u32,
     /// Radiance of the environment seen through openings (linear RGB).
     pub environment: [f64; 3],
+    /// Number of windows in the back wall, drawn from `[min, max]`.
+    pub windows: [u32; 2],
+    /// Probability of a door in the back wall.
+    pub door: f64,
+    /// Luminance range of the daylight seen through windows (linear).
+    pub window_light: [f64; 2],
     /// Asset catalogue (`catalog.json`) to draw pieces from besides the procedural furniture;
     /// empty: procedural only.
     pub catalog: String,
@@ -224,6 +230,9 @@ impl Default for SceneConfig {
             texture_seed: 0,
             lights: 4,
             environment: [0.2, 0.22, 0.25],
+            windows: [0, 2],
+            door: 0.35,
+            window_light: [3.0, 10.0],
             catalog: String::new(),
             catalog_share: 0.5,
             category_weights: std::collections::BTreeMap::new(),
@@ -393,6 +402,13 @@ impl SceneConfig {
         let probs = [self.semi_transparent, self.glass, self.cutout];
         if probs.iter().any(|p| !(0.0..=1.0).contains(p)) || self.opacity_range[1] > 1.0 {
             bail!("scene probabilities and opacities must lie in [0, 1]");
+        }
+        if self.windows[0] > self.windows[1] || self.windows[1] > 4 {
+            bail!("scene.windows must be [min, max] with min <= max <= 4");
+        }
+        let [a, b] = self.window_light;
+        if !(0.0..=1.0).contains(&self.door) || !(a.is_finite() && 0.0 <= a && a <= b) {
+            bail!("scene.door must lie in [0, 1] and scene.window_light be a [min, max] range");
         }
         if !(0.0..=1.0).contains(&self.catalog_share) {
             bail!("scene.catalog_share must lie in [0, 1]");

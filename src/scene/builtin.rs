@@ -9,6 +9,7 @@
 
 use super::furniture::{self, Kind, MaterialSource, Piece, Placement, Role};
 use super::library::AssetLibrary;
+use super::openings::{Opening, OpeningKind, REVEAL, skirting_runs};
 use super::placement::{Body, Footprint, Layer, Layout, PlacementReport, WorldSurface};
 use super::{
     Material, Object, Opacity, SceneDesc, Shape, SliceRange, SourceFile, SurfaceModel, Texture,
@@ -48,6 +49,7 @@ pub fn generate(cfg: &Config, index: u64, library: Option<&AssetLibrary>) -> Sce
         materials: Vec::new(),
         objects: Vec::new(),
         sources: Vec::new(),
+        openings: Vec::new(),
     };
     let s = &cfg.scene;
     let size = Vec3::new(
@@ -84,6 +86,8 @@ struct Gen<'a> {
     objects: Vec<Object>,
     /// Model files of the catalogue pieces placed so far.
     sources: Vec<SourceFile>,
+    /// Window and door openings of the back wall.
+    openings: Vec<Opening>,
 }
 
 /// What a furniture slot of a scene is filled with.
@@ -396,12 +400,6 @@ impl Gen<'_> {
                 ceiling,
             ),
             (
-                "wall_back",
-                [w, h],
-                quad(Vec3::new(0.0, h / 2.0, -d / 2.0), Quat::IDENTITY),
-                back,
-            ),
-            (
                 "wall_front",
                 [w, h],
                 quad(Vec3::new(0.0, h / 2.0, d / 2.0), Quat::from_rotation_y(PI)),
@@ -429,8 +427,199 @@ impl Gen<'_> {
         for (name, size, xf, m) in faces {
             self.add(name, Shape::Quad { size }, xf, m);
         }
+        self.openings = self.draw_openings(size);
+        let holes = self.openings.iter().map(|o| o.hole(h)).collect();
+        let back_xf = quad(Vec3::new(0.0, h / 2.0, -d / 2.0), Quat::IDENTITY);
+        self.add(
+            "wall_back",
+            Shape::Wall {
+                size: [w, h],
+                holes,
+            },
+            back_xf,
+            back,
+        );
+        self.outside(size, back);
         if self.chance(0.7) {
             self.skirting(size);
+        }
+    }
+
+    /// Up to `scene.windows` windows and, by chance `scene.door`, a door in the back wall,
+    /// at random places that keep apart.
+    fn draw_openings(&mut self, size: Vec3) -> Vec<Opening> {
+        let s = &self.cfg.scene;
+        let (door, [lo, hi]) = (s.door, s.windows);
+        let mut wanted = Vec::new();
+        if self.chance(door) {
+            let (w, top) = (
+                self.between(0.8, 1.0),
+                self.between(2.0, 2.2).min(size.y - 0.2),
+            );
+            wanted.push((OpeningKind::Door, w, 0.0, top));
+        }
+        for _ in 0..self.rng.random_range(lo..=hi) {
+            let sill = self.between(0.5, 1.0);
+            let top = (sill + self.between(0.8, 1.6)).min(size.y - 0.25);
+            wanted.push((OpeningKind::Window, self.between(0.7, 1.8), sill, top));
+        }
+        let mut placed: Vec<Opening> = Vec::new();
+        for (kind, width, y0, y1) in wanted {
+            for _ in 0..20 {
+                let x0 = self.between(-size.x / 2.0, size.x / 2.0 - width);
+                let o = Opening {
+                    kind,
+                    x0,
+                    x1: x0 + width,
+                    y0,
+                    y1,
+                };
+                if o.fits(size.x, &placed) {
+                    placed.push(o);
+                    break;
+                }
+            }
+        }
+        placed
+    }
+
+    /// What lies beyond the back wall's openings: their reveals, window panes and bars, a
+    /// corridor behind a door, and the daylight backdrop behind the windows.
+    fn outside(&mut self, size: Vec3, wall: u32) {
+        let z = -size.z / 2.0;
+        for o in self.openings.clone() {
+            self.reveal(&o, z, wall);
+            match o.kind {
+                OpeningKind::Window => self.window(&o, z),
+                OpeningKind::Door => self.corridor(&o, z, wall),
+            }
+        }
+        if self.openings.iter().any(|o| o.kind == OpeningKind::Window) {
+            let dist = self.between(0.5, 2.0);
+            let kelvin = self.between(5500.0, 7500.0);
+            let light = self.range(self.cfg.scene.window_light);
+            let mut m = self.standard(
+                "daylight",
+                Texture::constant([0.8; 3]),
+                1.0,
+                Opacity::constant(1.0),
+            );
+            m.emission = kelvin_rgb(kelvin).map(|c| c * light);
+            let m = self.push_material(m);
+            let xf = Transform::at(Vec3::new(0.0, size.y / 2.0, z - REVEAL - dist));
+            let backdrop = [size.x + 4.0 * dist + 2.0, size.y + 4.0 * dist + 2.0];
+            self.add("outside_daylight", Shape::Quad { size: backdrop }, xf, m);
+        }
+    }
+
+    /// The four faces of the wall's thickness around an opening, facing into it.
+    fn reveal(&mut self, o: &Opening, z: f32, wall: u32) {
+        let zc = z - REVEAL / 2.0;
+        let (w, h) = (o.width(), o.y1 - o.y0);
+        let yc = (o.y0 + o.y1) / 2.0;
+        let faces = [
+            (
+                [REVEAL, h],
+                Vec3::new(o.x0, yc, zc),
+                Quat::from_rotation_y(FRAC_PI_2),
+            ),
+            (
+                [REVEAL, h],
+                Vec3::new(o.x1, yc, zc),
+                Quat::from_rotation_y(-FRAC_PI_2),
+            ),
+            (
+                [w, REVEAL],
+                Vec3::new(o.centre_x(), o.y0, zc),
+                Quat::from_rotation_x(-FRAC_PI_2),
+            ),
+            (
+                [w, REVEAL],
+                Vec3::new(o.centre_x(), o.y1, zc),
+                Quat::from_rotation_x(FRAC_PI_2),
+            ),
+        ];
+        for (size, at, rotation) in faces {
+            let xf = Transform {
+                translation: at,
+                rotation,
+                scale: Vec3::ONE,
+            };
+            self.add("outside_reveal", Shape::Quad { size }, xf, wall);
+        }
+    }
+
+    /// A window's glass pane (most windows) and glazing bars (some).
+    fn window(&mut self, o: &Opening, z: f32) {
+        let (w, h) = (o.width(), o.y1 - o.y0);
+        let centre = Vec3::new(o.centre_x(), (o.y0 + o.y1) / 2.0, z - REVEAL / 2.0);
+        if self.chance(0.75) {
+            let glass = self.glass("window_glass");
+            self.add(
+                "outside_pane",
+                Shape::Quad { size: [w, h] },
+                Transform::at(centre),
+                glass,
+            );
+        }
+        if self.chance(0.5) {
+            let c = self.color().map(|v| (v + 0.5).min(0.95));
+            let m = self.standard(
+                "window_bars",
+                Texture::constant(c),
+                0.5,
+                Opacity::constant(1.0),
+            );
+            let m = self.push_material(m);
+            let t = 0.04;
+            let bar = |size: Vec3| Shape::Cuboid { size };
+            let at = Transform::at(centre + Vec3::Z * (t / 2.0 + 0.005));
+            self.add("outside_bar", bar(Vec3::new(t, h, t)), at, m);
+            self.add("outside_bar", bar(Vec3::new(w, t, t)), at, m);
+        }
+    }
+
+    /// A short unlit corridor behind a door: floor, ceiling, side walls and an end wall.
+    fn corridor(&mut self, o: &Opening, z: f32, wall: u32) {
+        let len = self.between(1.2, 2.5);
+        let width = o.width() + self.between(0.4, 1.2);
+        let height = o.y1 + self.between(0.2, 0.4);
+        let (x, zc, z_end) = (o.centre_x(), z - REVEAL - len / 2.0, z - REVEAL - len);
+        let face = |at: Vec3, rotation: Quat| Transform {
+            translation: at,
+            rotation,
+            scale: Vec3::ONE,
+        };
+        let faces = [
+            (
+                [width, len],
+                face(Vec3::new(x, 0.0, zc), Quat::from_rotation_x(-FRAC_PI_2)),
+            ),
+            (
+                [width, len],
+                face(Vec3::new(x, height, zc), Quat::from_rotation_x(FRAC_PI_2)),
+            ),
+            (
+                [len, height],
+                face(
+                    Vec3::new(x - width / 2.0, height / 2.0, zc),
+                    Quat::from_rotation_y(FRAC_PI_2),
+                ),
+            ),
+            (
+                [len, height],
+                face(
+                    Vec3::new(x + width / 2.0, height / 2.0, zc),
+                    Quat::from_rotation_y(-FRAC_PI_2),
+                ),
+            ),
+            (
+                [width, height],
+                face(Vec3::new(x, height / 2.0, z_end), Quat::IDENTITY),
+            ),
+        ];
+        for (size, xf) in faces {
+            self.add("outside_corridor", Shape::Quad { size }, xf, wall);
         }
     }
 
@@ -446,11 +635,13 @@ impl Gen<'_> {
         let m = self.push_material(m);
         let [sh, st] = SKIRTING;
         let (w, d) = (size.x, size.z);
-        let boards = [
+        let back = skirting_runs(w, &self.openings).into_iter().map(|[a, b]| {
             (
-                Vec3::new(w, sh, st),
-                Vec3::new(0.0, sh / 2.0, -d / 2.0 + st / 2.0),
-            ),
+                Vec3::new(b - a, sh, st),
+                Vec3::new((a + b) / 2.0, sh / 2.0, -d / 2.0 + st / 2.0),
+            )
+        });
+        let boards = [
             (
                 Vec3::new(w, sh, st),
                 Vec3::new(0.0, sh / 2.0, d / 2.0 - st / 2.0),
@@ -464,7 +655,7 @@ impl Gen<'_> {
                 Vec3::new(w / 2.0 - st / 2.0, sh / 2.0, 0.0),
             ),
         ];
-        for (size, at) in boards {
+        for (size, at) in boards.into_iter().chain(back) {
             self.add("skirting", Shape::Cuboid { size }, Transform::at(at), m);
         }
     }
@@ -531,6 +722,9 @@ impl Gen<'_> {
         picks.sort_by_key(|&p| self.placement_of(p) == Placement::OnTop);
         let view = View::of(cam, room);
         let mut layout = Layout::new(room);
+        for o in &self.openings {
+            layout.add(o.keep_clear(-room.z / 2.0));
+        }
         let mut report = PlacementReport {
             requested: picks.len() as u32,
             ..PlacementReport::default()
@@ -851,6 +1045,7 @@ mod tests {
                 materials: Vec::new(),
                 objects: Vec::new(),
                 sources: Vec::new(),
+                openings: Vec::new(),
             };
             let room = Vec3::new(
                 g.range(c.scene.room_width),
@@ -937,13 +1132,72 @@ mod tests {
                 tris.clear();
                 tessellate(&o.shape, &o.transform, &Assets::default(), &mut tris).unwrap();
                 for p in tris.iter().flat_map(|t| t.p) {
-                    let inside = p.x.abs() <= room.x / 2.0 + 1e-3
-                        && p.z.abs() <= room.y / 2.0 + 1e-3
-                        && (-1e-3..=height + 1e-3).contains(&p.y);
+                    // What lies beyond the openings is behind the back wall, all else inside.
+                    let inside = match o.name.starts_with("outside_") {
+                        true => p.z <= -room.y / 2.0 + 1e-3,
+                        false => {
+                            p.x.abs() <= room.x / 2.0 + 1e-3
+                                && p.z.abs() <= room.y / 2.0 + 1e-3
+                                && (-1e-3..=height + 1e-3).contains(&p.y)
+                        }
+                    };
                     assert!(inside, "seed {seed}: {} has a vertex at {p}", o.name);
                 }
             }
         }
+    }
+
+    /// Openings appear, the back wall has exactly their holes, windows have daylight behind
+    /// them, and no piece hangs across a window or stands in a doorway.
+    #[test]
+    fn openings_are_cut_lit_and_kept_clear() {
+        use crate::scene::assets::Assets;
+        use crate::scene::shapes::tessellate;
+        let (mut windows, mut doors) = (0, 0);
+        for seed in 0..20 {
+            let desc = generate(&cfg(seed), seed, None);
+            let wall = desc.objects.iter().find(|o| o.name == "wall_back").unwrap();
+            let (Shape::Wall { size, holes }, z) = (&wall.shape, wall.transform.translation.z)
+            else {
+                panic!("the back wall is a wall with holes");
+            };
+            let daylight = desc.objects.iter().any(|o| o.name == "outside_daylight");
+            let mut lit = false;
+            for h in holes {
+                let (x0, x1, y0, y1) = (h[0], h[2], h[1] + size[1] / 2.0, h[3] + size[1] / 2.0);
+                let door = y0 == 0.0;
+                (doors, windows) = (doors + door as u32, windows + !door as u32);
+                lit |= !door;
+                // Nothing but the room and the outside within 3 cm of the wall in the hole
+                // (pictures), nor in the 0.9 m in front of a door.
+                let reach = if door { 0.9 } else { 0.03 };
+                let mut tris = Vec::new();
+                for o in desc
+                    .objects
+                    .iter()
+                    .filter(|o| o.name.starts_with("object_"))
+                {
+                    tris.clear();
+                    tessellate(&o.shape, &o.transform, &Assets::default(), &mut tris).unwrap();
+                    for p in tris.iter().flat_map(|t| t.p) {
+                        let blocks = p.x > x0 + 1e-3
+                            && p.x < x1 - 1e-3
+                            && p.y > y0 + 0.02
+                            && p.y < y1 - 1e-3
+                            && p.z < z + reach;
+                        assert!(!blocks, "seed {seed}: {} at {p} in opening {h:?}", o.name);
+                    }
+                }
+            }
+            assert_eq!(
+                lit, daylight,
+                "seed {seed}: daylight exactly behind windows"
+            );
+        }
+        assert!(
+            windows >= 10 && doors >= 3,
+            "{windows} windows, {doors} doors"
+        );
     }
 
     #[test]

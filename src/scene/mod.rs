@@ -16,6 +16,7 @@ pub mod library;
 pub mod light;
 pub mod material;
 pub mod obj;
+pub mod openings;
 pub mod placement;
 pub mod shapes;
 pub mod texture_image;
@@ -162,6 +163,13 @@ pub enum Shape {
     Room { size: Vec3 },
     /// Rectangle in the local XY plane centred at the origin, normal +Z.
     Quad { size: [f32; 2] },
+    /// A [`Shape::Quad`] with rectangular holes (window and door openings), each
+    /// `[x0, y0, x1, y1]` in the quad's frame (origin at its centre); holes may not overlap
+    /// along X. UVs are those of the whole quad, so a texture runs on across the openings.
+    Wall {
+        size: [f32; 2],
+        holes: Vec<[f32; 4]>,
+    },
     /// UV sphere centred at the origin.
     Sphere {
         radius: f32,

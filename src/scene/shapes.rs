@@ -33,6 +33,7 @@ pub fn tessellate(
                 .map(|v| v * Vec3::new(size[0], size[1], 1.0)),
             out,
         ),
+        Shape::Wall { size, ref holes } => wall(size, holes, out),
         Shape::Sphere {
             radius,
             rings,
@@ -87,6 +88,39 @@ fn quad([origin, eu, ev]: [Vec3; 3], out: &mut Vec<MeshTri>) {
             uv: [uv[a], uv[b], uv[d]],
         });
     }
+}
+
+/// A `size` rectangle centred at the origin (normal +Z) minus `holes`: a full-height strip
+/// between holes, and below and above each hole a strip of its width. UVs in metres from the
+/// rectangle's corner, continuous across the strips.
+fn wall(size: [f32; 2], holes: &[[f32; 4]], out: &mut Vec<MeshTri>) {
+    let [hw, hh] = [size[0] / 2.0, size[1] / 2.0];
+    let mut holes: Vec<[f32; 4]> = holes.to_vec();
+    holes.sort_by(|a, b| a[0].total_cmp(&b[0]));
+    let mut rect = |x0: f32, y0: f32, x1: f32, y1: f32| {
+        if x1 > x0 && y1 > y0 {
+            let start = out.len();
+            quad(
+                [
+                    Vec3::new(x0, y0, 0.0),
+                    Vec3::X * (x1 - x0),
+                    Vec3::Y * (y1 - y0),
+                ],
+                out,
+            );
+            for t in &mut out[start..] {
+                t.uv = t.uv.map(|uv| uv + Vec2::new(x0 + hw, y0 + hh));
+            }
+        }
+    };
+    let mut x = -hw;
+    for &[x0, y0, x1, y1] in &holes {
+        rect(x, -hh, x0, hh);
+        rect(x0, -hh, x1, y0);
+        rect(x0, y1, x1, hh);
+        x = x1;
+    }
+    rect(x, -hh, hw, hh);
 }
 
 /// Six faces of a box centred at `centre`; `inward` flips every face (a room seen from inside).
@@ -288,6 +322,10 @@ mod tests {
                 segments: 16,
             },
             Shape::Quad { size: [1.0, 2.0] },
+            Shape::Wall {
+                size: [4.0, 3.0],
+                holes: vec![[0.5, -1.5, 1.4, 0.6], [-1.5, -0.5, -0.5, 0.8]],
+            },
             Shape::Lathe {
                 profile: vec![[0.0, 0.0], [0.3, 0.1], [0.2, 0.5], [0.25, 0.8], [0.0, 0.9]],
                 segments: 24,
@@ -317,6 +355,35 @@ mod tests {
         for t in out {
             let ng = (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]);
             assert!(ng.dot(t.n[0]) > 0.0 && t.n[0] == Vec3::Z, "{t:?}");
+        }
+    }
+
+    /// The wall's area is the rectangle's minus its holes, nothing lies inside a hole, and the
+    /// UV of every vertex is its position from the corner (continuous texture).
+    #[test]
+    fn walls_leave_their_holes_open_and_keep_one_uv_frame() {
+        let holes = vec![[0.5, -1.5, 1.4, 0.6], [-1.5, -0.5, -0.5, 0.8]];
+        let t = tris(Shape::Wall {
+            size: [4.0, 3.0],
+            holes: holes.clone(),
+        });
+        let area: f32 = t
+            .iter()
+            .map(|t| (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]).length() / 2.0)
+            .sum();
+        let open: f32 = holes.iter().map(|h| (h[2] - h[0]) * (h[3] - h[1])).sum();
+        assert!((area - (12.0 - open)).abs() < 1e-4, "{area}");
+        // tris() places the shape at (1, 2, 3).
+        for tri in &t {
+            let p = tri.p.map(|p| p - Vec3::new(1.0, 2.0, 3.0));
+            let c = (p[0] + p[1] + p[2]) / 3.0;
+            for h in &holes {
+                let inside = c.x > h[0] && c.x < h[2] && c.y > h[1] && c.y < h[3];
+                assert!(!inside, "triangle centre {c} in hole {h:?}");
+            }
+            for (p, uv) in p.iter().zip(tri.uv) {
+                assert!((uv - Vec2::new(p.x + 2.0, p.y + 1.5)).length() < 1e-5);
+            }
         }
     }
 
