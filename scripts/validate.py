@@ -174,6 +174,15 @@ def cmd_match(a):
             # Diffuse + glossy only: no metals, no glass (the issue's matched setting).
             m["metallic"] = 0.0
             m["model"] = {"type": "standard"}
+        if a.diffuse:
+            # Pure Lambert everywhere (lfgen's Standard model without its glossy layer), which
+            # every renderer has exactly: Mitsuba `diffuse`, Cycles Diffuse BSDF at roughness 0.
+            m["model"] = {"type": "diffuse"}
+            m["metallic"] = 0.0
+        if a.roughness is not None and m["model"]["type"] == "standard" and not any(m["emission"]):
+            m["roughness"] = a.roughness
+        if a.metallic is not None and m["model"]["type"] == "standard" and not any(m["emission"]):
+            m["metallic"] = a.metallic
     # One view (the centre camera): timings compare one image with one image.
     desc["camera"]["grid"] = [1, 1]
     json.dump(desc, open(a.out_json, "w"))
@@ -188,28 +197,177 @@ def block_stats(ref, img, n=8):
 
 
 def cmd_colour(a):
+    """One table: lfgen's linear EXR against each reference renderer at the same spp."""
     ref = rgb(read_exr(a.lfgen_exr))
-    lf_time = float(open(a.lfgen_time).read())
-    print("| renderer | spp | mean rel. diff (8×8 blocks) | p90 | total energy diff | wall clock | lfgen / renderer |")
-    print("|---|---|---|---|---|---|---|")
-    print(f"| lfgen | {a.spp} | – | – | – | {lf_time:.1f} s | 1 |")
-    import mitsuba as mi
+    h, w = ref.shape[:2]
+    # "wall [cpu]" seconds (validate.py timed); CPU time = user + system of the process tree,
+    # which other jobs sharing the cores inflate much less than the wall clock.
+    lf_wall, lf_cpu = (open(a.lfgen_time).read().split() + [None])[:2]
+    lf_time, lf_cpu = float(lf_wall), float(lf_cpu) if lf_cpu else float("nan")
+    if a.title:
+        print(f"\n{a.title}\n")
+    print("| renderer | BSDF | spp | mean rel. diff (8×8 blocks) | p90 | total energy diff "
+          "| wall clock | lfgen / renderer | CPU time | lfgen / renderer (CPU) |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    print(f"| lfgen | {a.lfgen_bsdf_name} | {a.spp} | – | – | – | {lf_time:.1f} s | 1 "
+          f"| {lf_cpu:.1f} s | 1 |")
 
-    mi.set_variant("scalar_rgb")
-    t0 = time.time()
-    scene = mi.load_file(os.path.join(a.mitsuba, "scene.xml"), spp=a.spp)
-    img = np.array(mi.render(scene, sensor=0), dtype=np.float64)[..., :3]
-    t = time.time() - t0
-    mean, p90, energy = block_stats(ref, img)
-    print(f"| Mitsuba 3 | {a.spp} | {100 * mean:.2f} % | {100 * p90:.2f} % | {100 * energy:+.2f} % | {t:.1f} s | {lf_time / t:.2f} |")
+    def row(name, bsdf, img, t, cpu):
+        mean, p90, energy = block_stats(ref, img)
+        print(f"| {name} | {bsdf} | {a.spp} | {100 * mean:.2f} % | {100 * p90:.2f} % | "
+              f"{100 * energy:+.2f} % | {t:.1f} s | {lf_time / t:.2f} | {cpu:.1f} s "
+              f"| {lf_cpu / cpu:.2f} |", flush=True)
+
+    for variant in a.variants.split(",") if a.mitsuba else []:
+        xml = os.path.join(a.mitsuba, "scene.xml")
+        bsdf = "principled / diffuse"
+        if a.lfgen_bsdf:
+            # lfgen's own Standard model (scripts/lfgen_bsdf.py) in place of `principled`.
+            text = open(xml).read().replace('type="principled"', 'type="lfgen_standard"')
+            xml = os.path.join(a.mitsuba, "scene_lfgen.xml")
+            open(xml, "w").write(text)
+            bsdf = "lfgen_standard / diffuse"
+        out = os.path.join(a.work, f"mitsuba_{variant}.npy")
+        t0, c0 = time.time(), children_cpu()
+        # A process per render: one Mitsuba variant per process, and the wall clock includes
+        # start-up (and the JIT compilation of llvm variants) as lfgen's and Blender's do.
+        cmd = [sys.executable, os.path.abspath(__file__), "mitsuba-render", xml, out,
+               "--variant", variant, "--spp", str(a.spp)]
+        r = subprocess.run(cmd, capture_output=True, text=True)
+        if r.returncode != 0:
+            sys.exit(f"mitsuba failed: {' '.join(cmd)}\n{r.stdout[-2000:]}\n{r.stderr[-2000:]}")
+        row(f"Mitsuba 3 `{variant}`", bsdf, np.load(out), time.time() - t0, children_cpu() - c0)
     if a.blender:
         out = os.path.join(a.work, "blender_colour.exr")
-        t0 = time.time()
-        run_blender(a.blender, ["--view", "0", "--out", out, "--spp", str(a.spp)])
-        t = time.time() - t0
-        img = rgb(read_exr(out))
-        mean, p90, energy = block_stats(ref, img)
-        print(f"| Cycles | {a.spp} | {100 * mean:.2f} % | {100 * p90:.2f} % | {100 * energy:+.2f} % | {t:.1f} s | {lf_time / t:.2f} |")
+        t0, c0 = time.time(), children_cpu()
+        run_blender(a.blender, ["--view", "0", "--out", os.path.abspath(out), "--spp", str(a.spp)])
+        row("Cycles", "Principled / Diffuse", rgb(read_exr(out)), time.time() - t0,
+            children_cpu() - c0)
+    if a.pov:
+        out = os.path.join(a.work, "pov_direct.exr")
+        t0, c0 = time.time(), children_cpu()
+        img = render_pov_direct(a.pov, 0, w, h, a.pov_supersample, out)
+        row(f"POV-Ray 3.7 ({a.pov_supersample}² rays/px)", "Lambert, point-light grid", img,
+            time.time() - t0, children_cpu() - c0)
+
+
+def children_cpu():
+    """User + system seconds of all waited-for child processes so far."""
+    import resource
+
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+def cmd_timed(a):
+    """Runs a command and writes "wall cpu" seconds to a file (cpu: user + system)."""
+    t0, c0 = time.time(), children_cpu()
+    r = subprocess.run(a.command)
+    if r.returncode != 0:
+        sys.exit(r.returncode)
+    with open(a.out, "w") as f:
+        f.write(f"{time.time() - t0} {children_cpu() - c0}\n")
+
+
+def cmd_mitsuba_render(a):
+    import mitsuba as mi
+
+    mi.set_variant(a.variant)
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import lfgen_bsdf
+
+    lfgen_bsdf.register()
+    scene = mi.load_file(a.xml, spp=a.spp)
+    img = np.array(mi.render(scene, sensor=0, seed=a.seed), dtype=np.float64)[..., :3]
+    np.save(a.out, img)
+
+
+def read_obj_triangles(path):
+    """World-space triangles (n, 3, 3) of an exported OBJ (every face a triangle)."""
+    v, faces = [], []
+    for line in open(path):
+        if line.startswith("v "):
+            v.append([float(x) for x in line.split()[1:4]])
+        elif line.startswith("f "):
+            faces.append([int(c.split("/")[0]) - 1 for c in line.split()[1:4]])
+    return np.asarray(v, dtype=np.float64)[np.asarray(faces, dtype=np.int64)]
+
+
+def sub_lights(tri, target_area):
+    """Centroids, area and unit normal of the n² equal sub-triangles of `tri` (n chosen so
+    each is at most `target_area`): the midpoint rule for the emitter's area integral."""
+    p0, p1, p2 = tri
+    cross = np.cross(p1 - p0, p2 - p0)
+    area = 0.5 * np.linalg.norm(cross)
+    n = max(1, int(np.ceil(np.sqrt(area / target_area))))
+    a, b = (p1 - p0) / n, (p2 - p0) / n
+    cents = []
+    for i in range(n):
+        for j in range(n - i):
+            cents.append(p0 + (i + 1 / 3) * a + (j + 1 / 3) * b)  # upward (i,j),(i+1,j),(i,j+1)
+            if i + j < n - 1:
+                cents.append(p0 + (i + 2 / 3) * a + (j + 2 / 3) * b)  # downward
+    return np.asarray(cents), area / (n * n), cross / (2.0 * area)
+
+
+# POV-Ray attenuates a light by 2 / (1 + (d/FADE)²) with fade_power 2: 2·FADE²/d² for a tiny
+# FADE, so colours are scaled by 1/(2·FADE²) to give the inverse-square law exactly.
+POV_FADE = 1e-3
+
+
+def cmd_povdirect(a):
+    """direct.pov: lfgen's direct light (camera hit + one light bounce, Lambert) in POV-Ray.
+
+    Every emitter triangle becomes n² point lights at the centroids of its equal sub-triangles,
+    each a spotlight with `radius 90 falloff 90 tightness 1` (attenuation exactly cos θ about
+    the emitter normal; checked against cos θ by rendering a plane) of intensity L·A_sub along
+    the normal: a Lambertian emitter of radiance L, integrated by the midpoint rule (error
+    O((size/distance)²), ~0.1 % for `--light-area` 0.01 m² at 1 m). Surfaces: pigment = the
+    exported mean colour, `diffuse 1/π` (POV-Ray's diffuse term is k·colour·I·cos θ, so the
+    radiance is albedo/π · E as lfgen's), `ambient 0`, no specular, no radiosity; emitters
+    show their emission and cast no shadow (lfgen's shadow rays stop short of the light).
+    """
+    data = json.load(open(os.path.join(a.blender, "blender_scene.json")))
+    mats = data["materials"]
+    out = ['#version 3.7;', 'global_settings { assumed_gamma 1.0 max_trace_level 5 }',
+           '#include "cameras.inc"', '#include "geometry.inc"',
+           "background {{ rgb <{}, {}, {}> }}".format(*data["environment"])]
+    num = lambda x: repr(float(x))
+    to_pov = lambda p: f"<{num(p[0])}, {num(p[1])}, {num(-p[2])}>"  # POV-Ray mirrors z
+    n_lights = 0
+    for o in data["objects"]:
+        m = mats[o["material"]]
+        c, e = m["color"], m["emission"]
+        if max(e) > 0:
+            out.append(f"object {{ {o['id']} texture {{ pigment {{ rgb 1 }} finish {{ ambient 0 "
+                       f"diffuse 0 emission <{e[0]}, {e[1]}, {e[2]}> }} }} no_shadow }}")
+            for tri in read_obj_triangles(os.path.join(a.blender, o["mesh"])):
+                cents, sub_area, normal = sub_lights(tri, a.light_area)
+                col = np.asarray(e) * sub_area / (2.0 * POV_FADE ** 2)
+                for p in cents:
+                    out.append(
+                        f"light_source {{ {to_pov(p)} rgb <{num(col[0])}, {num(col[1])}, {num(col[2])}> "
+                        f"spotlight point_at {to_pov(p + normal)} radius 90 falloff 90 tightness 1 "
+                        f"fade_distance {POV_FADE} fade_power 2 }}")
+                    n_lights += 1
+        else:
+            out.append(f"object {{ {o['id']} texture {{ pigment {{ rgb <{c[0]}, {c[1]}, {c[2]}> }} "
+                       f"finish {{ ambient 0 diffuse {1 / np.pi!r} specular 0 phong 0 }} }} }}")
+    with open(os.path.join(a.pov, "direct.pov"), "w") as f:
+        f.write("\n".join(out) + "\n")
+    print(f"direct.pov: {n_lights} point lights")
+
+
+def render_pov_direct(pov_dir, view, w, h, supersample, out_exr):
+    """Renders direct.pov at `supersample`× the resolution (no anti-aliasing: one ray per
+    sub-pixel centre) and box-filters it down: lfgen's box-filtered pixel."""
+    cmd = ["povray", "+Idirect.pov", f"+O{os.path.abspath(out_exr)}", "+FE", f"+W{w * supersample}",
+           f"+H{h * supersample}", "-A", "-D", "File_Gamma=1.0", f"Declare=View={view}", "+WT2"]
+    r = subprocess.run(cmd, cwd=pov_dir, capture_output=True, text=True)
+    if r.returncode != 0:
+        sys.exit(f"povray failed: {' '.join(cmd)}\n{r.stderr[-2000:]}")
+    img = rgb(read_exr(out_exr))
+    return img.reshape(h, supersample, w, supersample, 3).mean(axis=(1, 3))
 
 
 def main():
@@ -226,15 +384,38 @@ def main():
     m.add_argument("out_json")
     m.add_argument("--keep-opacity", action="store_true", help="keep mean opacities (else opaque)")
     m.add_argument("--dielectric-only", action="store_true", help="metallic 0, glass made standard")
+    m.add_argument("--diffuse", action="store_true", help="every material pure Lambert")
+    m.add_argument("--roughness", type=float, help="one roughness for every Standard material")
+    m.add_argument("--metallic", type=float, help="one metallic for every Standard material")
     c = sub.add_parser("colour")
     c.add_argument("lfgen_exr")
     c.add_argument("lfgen_time")
-    c.add_argument("mitsuba")
-    c.add_argument("--blender")
+    c.add_argument("--mitsuba", help="Mitsuba export folder")
+    c.add_argument("--variants", default="scalar_rgb", help="Mitsuba variants, comma-separated")
+    c.add_argument("--lfgen-bsdf", action="store_true", help="Mitsuba renders lfgen's Standard model")
+    c.add_argument("--lfgen-bsdf-name", default="Standard", help="lfgen's model, for the table")
+    c.add_argument("--blender", help="Blender export folder")
+    c.add_argument("--pov", help="POV-Ray export folder with direct.pov (see povdirect)")
+    c.add_argument("--pov-supersample", type=int, default=2)
     c.add_argument("--spp", type=int, default=256)
+    c.add_argument("--title")
     c.add_argument("--work", default=".")
+    t = sub.add_parser("timed")
+    t.add_argument("out")
+    t.add_argument("command", nargs=argparse.REMAINDER)
+    r = sub.add_parser("mitsuba-render")
+    r.add_argument("xml")
+    r.add_argument("out")
+    r.add_argument("--variant", default="scalar_rgb")
+    r.add_argument("--spp", type=int, default=256)
+    r.add_argument("--seed", type=int, default=0)
+    v = sub.add_parser("povdirect")
+    v.add_argument("pov", help="POV-Ray export folder (cameras.inc, geometry.inc)")
+    v.add_argument("blender", help="Blender export folder of the same scene (materials, meshes)")
+    v.add_argument("--light-area", type=float, default=0.01, help="largest point-light patch, m²")
     a = p.parse_args()
-    {"depth": cmd_depth, "match": cmd_match, "colour": cmd_colour}[a.cmd](a)
+    {"depth": cmd_depth, "match": cmd_match, "colour": cmd_colour,
+     "mitsuba-render": cmd_mitsuba_render, "povdirect": cmd_povdirect, "timed": cmd_timed}[a.cmd](a)
 
 
 if __name__ == "__main__":

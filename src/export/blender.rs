@@ -40,8 +40,12 @@ pub fn write(scene: &ExportScene, out: &Path, max_depth: u32) -> Result<()> {
         "cameras": scene.cameras.iter().map(camera).collect::<Vec<_>>(),
         "materials": scene.desc.materials.iter().map(|m| json!({
             "name": m.name,
-            "kind": match m.model { SurfaceModel::Glass { .. } => "glass", SurfaceModel::Standard => "standard" },
-            "ior": match m.model { SurfaceModel::Glass { ior } => ior, SurfaceModel::Standard => 1.5 },
+            "kind": match m.model {
+                SurfaceModel::Glass { .. } => "glass",
+                SurfaceModel::Standard => "standard",
+                SurfaceModel::Diffuse => "diffuse",
+            },
+            "ior": match m.model { SurfaceModel::Glass { ior } => ior, _ => 1.5 },
             "color": mean_color(&m.base_color).to_array(),
             "roughness": m.roughness,
             "metallic": m.metallic,

@@ -53,6 +53,28 @@ def make_material(m):
         bsdf.inputs["IOR"].default_value = m["ior"]
         links.new(bsdf.outputs[0], out.inputs["Surface"])
         return mat
+    if m["kind"] == "diffuse":
+        # Lambert (Cycles' Diffuse BSDF at roughness 0), plus front-side emission and alpha.
+        nodes.remove(bsdf)
+        shader = nodes.new("ShaderNodeBsdfDiffuse")
+        shader.inputs["Color"].default_value = color
+        shader.inputs["Roughness"].default_value = 0.0
+        if max(m["emission"]) > 0.0:
+            emit = nodes.new("ShaderNodeEmission")
+            emit.inputs["Color"].default_value = (*m["emission"], 1.0)
+            links.new(front_side(nodes, links), emit.inputs["Strength"])
+            add = nodes.new("ShaderNodeAddShader")
+            links.new(shader.outputs[0], add.inputs[0])
+            links.new(emit.outputs[0], add.inputs[1])
+            shader = add
+        if m["opacity"] < 1.0:
+            mix = nodes.new("ShaderNodeMixShader")
+            mix.inputs["Fac"].default_value = m["opacity"]
+            links.new(nodes.new("ShaderNodeBsdfTransparent").outputs[0], mix.inputs[1])
+            links.new(shader.outputs[0], mix.inputs[2])
+            shader = mix
+        links.new(shader.outputs[0], out.inputs["Surface"])
+        return mat
     set_input(bsdf, ["Base Color"], color)
     set_input(bsdf, ["Roughness"], m["roughness"])
     set_input(bsdf, ["Metallic"], m["metallic"])
@@ -63,13 +85,18 @@ def make_material(m):
     if max(m["emission"]) > 0.0:
         # lfgen's emitters shine from their front side only: strength = 1 - backfacing.
         set_input(bsdf, ["Emission", "Emission Color"], (*m["emission"], 1.0))
-        geo = nodes.new("ShaderNodeNewGeometry")
-        front = nodes.new("ShaderNodeMath")
-        front.operation = "SUBTRACT"
-        front.inputs[0].default_value = 1.0
-        links.new(geo.outputs["Backfacing"], front.inputs[1])
-        links.new(front.outputs[0], bsdf.inputs["Emission Strength"])
+        links.new(front_side(nodes, links), bsdf.inputs["Emission Strength"])
     return mat
+
+
+def front_side(nodes, links):
+    """1 on the front side, 0 on the back (lfgen's emitters shine from their front only)."""
+    geo = nodes.new("ShaderNodeNewGeometry")
+    front = nodes.new("ShaderNodeMath")
+    front.operation = "SUBTRACT"
+    front.inputs[0].default_value = 1.0
+    links.new(geo.outputs["Backfacing"], front.inputs[1])
+    return front.outputs[0]
 
 
 def import_obj(path):
@@ -79,7 +106,16 @@ def import_obj(path):
         bpy.ops.wm.obj_import(filepath=full, forward_axis="NEGATIVE_Z", up_axis="Y")
     else:
         bpy.ops.import_scene.obj(filepath=full, axis_forward="-Z", axis_up="Y")
-    return [o for o in bpy.data.objects if o not in before]
+    objs = [o for o in bpy.data.objects if o not in before]
+    for o in objs:
+        # No shadow-terminator offsets (Cycles' default geometry offset 0.1 moves shadow-ray
+        # origins of smooth-shaded low-poly faces off the triangle and brightens them; lfgen
+        # spawns its rays from the triangle itself).
+        for owner in (o, getattr(o, "cycles", None)):
+            for name in ("shadow_terminator_geometry_offset", "shadow_terminator_offset"):
+                if owner is not None and hasattr(owner, name):
+                    setattr(owner, name, 0.0)
+    return objs
 
 
 def add_light(l):

@@ -122,13 +122,20 @@ fn sensor(c: &ExportCamera, s: &mut String) {
 }
 
 /// lfgen's Standard model (Lambert under GGX, `F0 = 0.04` for dielectrics, `α = roughness²`)
-/// is Mitsuba's `principled` with `specular = 0.5`; glass is a smooth `dielectric`.
+/// is written as Mitsuba's `principled` with `specular = 0.5` (the same parameters; its diffuse
+/// is Disney's, not lfgen's energy-compensated Lambert: `scripts/lfgen_bsdf.py` registers
+/// lfgen's own model under the same parameter names); Diffuse is `diffuse`; glass is a smooth
+/// `dielectric`.
 fn bsdf(i: usize, m: &Material, s: &mut String) {
     let c = mean_color(&m.base_color);
     let inner = match m.model {
         SurfaceModel::Glass { ior } => format!(
             "<bsdf type=\"dielectric\"><float name=\"int_ior\" value=\"{ior}\"/>\
              <float name=\"ext_ior\" value=\"1\"/><rgb name=\"specular_transmittance\" value=\"{}\"/></bsdf>",
+            rgb(c)
+        ),
+        SurfaceModel::Diffuse => format!(
+            "<bsdf type=\"twosided\"><bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"{}\"/></bsdf></bsdf>",
             rgb(c)
         ),
         SurfaceModel::Standard => format!(

@@ -227,7 +227,7 @@ fn colour_scene(scene: &ExportScene) -> String {
                 format!("rgbf <{}, {}, {}, 1>", c.x, c.y, c.z),
                 format!(" interior {{ ior {ior} }}"),
             ),
-            SurfaceModel::Standard => {
+            SurfaceModel::Standard | SurfaceModel::Diffuse => {
                 let t = 1.0 - mean_opacity(&mat.opacity);
                 (
                     format!("rgbt <{}, {}, {}, {t}>", c.x, c.y, c.z),

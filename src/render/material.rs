@@ -19,6 +19,8 @@ pub struct RenderMaterial {
     /// `Some(a)` when opacity is the same everywhere (skips the UV lookup).
     pub uniform_opacity: Option<f32>,
     pub glass_ior: Option<f32>,
+    /// Dielectric specular level of the Standard model (0 for [`SurfaceModel::Diffuse`]).
+    pub specular: f32,
     pub roughness: f32,
     pub metallic: f32,
     pub emission: Vec3,
@@ -190,10 +192,17 @@ impl RenderMaterial {
             opacity,
             glass_ior: match m.model {
                 SurfaceModel::Glass { ior } => Some(ior),
-                SurfaceModel::Standard => None,
+                SurfaceModel::Standard | SurfaceModel::Diffuse => None,
+            },
+            specular: match m.model {
+                SurfaceModel::Diffuse => 0.0,
+                SurfaceModel::Standard | SurfaceModel::Glass { .. } => 0.5,
             },
             roughness: m.roughness,
-            metallic: m.metallic,
+            metallic: match m.model {
+                SurfaceModel::Diffuse => 0.0,
+                SurfaceModel::Standard | SurfaceModel::Glass { .. } => m.metallic,
+            },
             emission: Vec3::from(m.emission),
         })
     }
@@ -205,7 +214,7 @@ impl RenderMaterial {
             base_color: self.base_color.eval(uv),
             roughness: self.roughness,
             metallic: self.metallic,
-            specular: 0.5,
+            specular: self.specular,
             kind: match self.glass_ior {
                 Some(ior) => SurfaceKind::Glass { ior },
                 None => SurfaceKind::Standard,

@@ -26,6 +26,10 @@ pub struct Material {
 pub enum SurfaceModel {
     /// Lambert diffuse under a GGX glossy layer.
     Standard,
+    /// Lambert diffuse alone: the Standard model with its glossy layer switched off
+    /// (`specular = 0`; `roughness` and `metallic` are ignored), for comparisons with other
+    /// renderers' plain diffuse BSDFs.
+    Diffuse,
     /// Smooth dielectric.
     Glass { ior: f32 },
 }
@@ -232,6 +236,16 @@ mod tests {
         assert_eq!(l.eval(Vec2::new(0.03, 0.001)), 0.0);
         assert_eq!(l.eval(Vec2::new(0.001, 0.1)), 0.0);
         assert_eq!(l.eval(Vec2::new(0.15, 0.3)), 1.0, "repeats");
+    }
+
+    #[test]
+    fn surface_models_serialise_by_type_tag() {
+        // Existing scene.json files keep their bytes: Standard stays `{"type":"standard"}`.
+        let json = |m: SurfaceModel| serde_json::to_string(&m).unwrap();
+        assert_eq!(json(SurfaceModel::Standard), r#"{"type":"standard"}"#);
+        assert_eq!(json(SurfaceModel::Diffuse), r#"{"type":"diffuse"}"#);
+        let back: SurfaceModel = serde_json::from_str(r#"{"type":"diffuse"}"#).unwrap();
+        assert_eq!(back, SurfaceModel::Diffuse);
     }
 
     #[test]
