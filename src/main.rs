@@ -47,6 +47,37 @@ enum Command {
         /// Dataset folder (with manifest.json).
         dataset: PathBuf,
     },
+    /// Download external model libraries and convert them into an asset catalogue.
+    Assets {
+        #[command(subcommand)]
+        command: AssetsCommand,
+    },
+}
+
+#[derive(Subcommand, Debug)]
+enum AssetsCommand {
+    /// Download a model library (apt-get) and write OUT/catalog.json, ATTRIBUTION.md and the
+    /// models.
+    Fetch(FetchArgs),
+}
+
+/// Model libraries `lfgen assets fetch` knows.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+enum AssetSource {
+    /// Sweet Home 3D's furniture: Debian's sweethome3d-furniture and sweethome3d packages.
+    Sweethome3d,
+}
+
+#[derive(Args, Debug)]
+struct FetchArgs {
+    /// Library to fetch.
+    source: AssetSource,
+    /// Output folder (the .deb files are cached in OUT/.cache/).
+    #[arg(long, default_value = "assets/sweethome3d")]
+    out: PathBuf,
+    /// Also convert models under non-free licences (non-commercial, no-derivatives, unknown).
+    #[arg(long)]
+    nonfree: bool,
 }
 
 /// Options shared by every command that loads a config.
@@ -161,6 +192,15 @@ fn run(cli: Cli) -> Result<()> {
                 "{}: {n} contact sheets and index.html",
                 dataset.join("previews").display()
             );
+            Ok(())
+        }
+        Some(Command::Assets {
+            command: AssetsCommand::Fetch(a),
+        }) => {
+            let summary = match a.source {
+                AssetSource::Sweethome3d => lfgen::catalog::sweethome3d::fetch(&a.out, a.nonfree)?,
+            };
+            print!("{summary}");
             Ok(())
         }
         Some(Command::Merge { dataset }) => {

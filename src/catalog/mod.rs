@@ -10,6 +10,7 @@ use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
+pub mod sweethome3d;
 
 /// Current schema version of `catalog.json`.
 pub const VERSION: u32 = 1;
