@@ -15,6 +15,7 @@
 //! Needs `povray` on the PATH (`.ci/run` installs it); without it the test prints why and passes.
 
 mod bin;
+mod pov;
 
 use glam::Vec3;
 use lfformat::pfm::read_pfm;
@@ -22,20 +23,12 @@ use lfgen::render::RenderScene;
 use lfgen::render::geometry::Hit;
 use lfgen::scene::assets::Assets;
 use std::path::Path;
-use std::process::Command;
 
 const WIDTH: u32 = 128;
 const HEIGHT: u32 = 96;
 /// Relative depth tolerance and the share of pixels that must meet it.
 const TOLERANCE: f64 = 1e-4;
 const REQUIRED: f64 = 0.999;
-
-fn povray_available() -> bool {
-    Command::new("povray")
-        .arg("--version")
-        .output()
-        .is_ok_and(|o| String::from_utf8_lossy(&o.stderr).contains("POV-Ray"))
-}
 
 fn lfgen(args: &[&str]) {
     bin::ok(bin::lfgen(args));
@@ -44,30 +37,18 @@ fn lfgen(args: &[&str]) {
 /// Renders `depth.pov` for one view; `fine` selects the base-256 fine digit.
 fn render_depth(pov_dir: &Path, view: u32, fine: bool) -> Vec<f64> {
     let png = pov_dir.join(format!("depth_{view}_{}.png", u8::from(fine)));
-    let out = Command::new("povray")
-        .current_dir(pov_dir)
-        .args([
-            "+Idepth.pov".to_string(),
-            format!("+O{}", png.display()),
-            format!("+W{WIDTH}"),
-            format!("+H{HEIGHT}"),
-            "-A".into(),
-            "+FN16".into(),
-            "Grayscale_Output=on".into(),
-            "File_Gamma=1.0".into(),
-            format!("Declare=View={view}"),
-            format!("Declare=Fine={}", u8::from(fine)),
-            "-D".into(),
-            "-GA".into(),
-            "+WT2".into(),
-        ])
-        .output()
-        .expect("povray runs");
-    assert!(
-        out.status.success(),
-        "povray failed on view {view}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let args = [
+        format!("+W{WIDTH}"),
+        format!("+H{HEIGHT}"),
+        "-A".into(),
+        "+FN16".into(),
+        "Grayscale_Output=on".into(),
+        "File_Gamma=1.0".into(),
+        format!("Declare=View={view}"),
+        format!("Declare=Fine={}", u8::from(fine)),
+        "+WT2".into(),
+    ];
+    pov::render(pov_dir, "depth.pov", &png, &args);
     let img = image::open(&png).expect("POV-Ray's PNG").into_luma16();
     img.pixels().map(|p| p.0[0] as f64 / 65535.0).collect()
 }
@@ -150,8 +131,8 @@ fn exclusion(
 
 #[test]
 fn povray_planar_depth_matches_hci_depth_of_centre_and_corner_views() {
-    if !povray_available() {
-        println!("SKIPPED: povray is not installed (apt-get install povray); .ci/run installs it");
+    if !pov::available() {
+        println!("{}", pov::SKIP);
         return;
     }
     let tmp = tempfile::tempdir().unwrap();

@@ -1,6 +1,8 @@
 //! POV-Ray 3.7 scene files: `geometry.inc` (meshes), `cameras.inc` (every view, chosen with
-//! `Declare=View=N`), `scene.pov` (colour, direct lighting) and `depth.pov` (exact planar depth
-//! as a pigment, for the depth check).
+//! `Declare=View=N`), `scene.pov` (colour, direct lighting), `depth.pov` (exact planar depth
+//! as a pigment, for the depth check) and `slices.pov` (the geometry of one ground-truth depth
+//! slice alone, chosen with `Declare=Slice=K`, its coverage as alpha: the thesis' S clipped
+//! renders).
 //!
 //! # Handedness
 //!
@@ -15,7 +17,8 @@
 use super::extract::{
     DepthVisibility, ExportCamera, ExportMesh, ExportScene, mean_color, mean_opacity,
 };
-use crate::scene::{Light, Opacity, SurfaceModel};
+use crate::config::SliceSpacing;
+use crate::scene::{Light, Opacity, SliceRange, SurfaceModel};
 use anyhow::Result;
 use glam::{DVec3, Vec3};
 use std::fmt::Write as _;
@@ -39,6 +42,7 @@ pub fn write(scene: &ExportScene, out: &Path) -> Result<()> {
     super::write_file(&out.join("geometry.inc"), &geometry(scene))?;
     super::write_file(&out.join("cameras.inc"), &cameras(scene))?;
     super::write_file(&out.join("depth.pov"), &depth_scene(scene))?;
+    super::write_file(&out.join("slices.pov"), &slice_scene(scene))?;
     super::write_file(&out.join("scene.pov"), &colour_scene(scene))?;
     Ok(())
 }
@@ -182,21 +186,112 @@ fn cutout_depth_texture(opacity: &Opacity) -> Option<String> {
 /// lfgen's cut-out patterns as POV-Ray functions of the UV (`x`, `y`): 0.75 where the surface
 /// is (opacity ≥ ½), 0.25 in the holes (values away from 0 and 1, which POV-Ray may wrap).
 fn cutout_pattern(opacity: &Opacity) -> Option<String> {
-    let frac = |c: &str, period: f32| format!("({c} / {period} - floor({c} / {period}))");
     match *opacity {
         Opacity::Grid { value, .. } if value < 0.5 => Some("0.25".to_string()),
-        Opacity::Grid { period, bar, .. } => Some(format!(
-            "select({} - {bar}, 0.75, select({} - {bar}, 0.75, 0.25))",
-            frac("x", period),
-            frac("y", period)
+        _ => cutout_shape(opacity).map(|(pattern, _)| pattern),
+    }
+}
+
+/// The shape of a cut-out as a POV-Ray function of the UV: 0.75 on the surface, 0.25 in the
+/// holes; with the opacity on the surface.
+fn cutout_shape(opacity: &Opacity) -> Option<(String, f32)> {
+    let frac = |c: &str, period: f32| format!("({c} / {period} - floor({c} / {period}))");
+    match *opacity {
+        Opacity::Grid { period, bar, value } => Some((
+            format!(
+                "select({} - {bar}, 0.75, select({} - {bar}, 0.75, 0.25))",
+                frac("x", period),
+                frac("y", period)
+            ),
+            value,
         )),
-        Opacity::Leaves { period: [pu, pv] } => Some(format!(
-            "select(abs({} - 0.5) - 0.42 * pow(sin(pi * {}), 0.8), 0.75, 0.25)",
-            frac("x", pu),
-            frac("y", pv)
+        Opacity::Leaves { period: [pu, pv] } => Some((
+            format!(
+                "select(abs({} - 0.5) - 0.42 * pow(sin(pi * {}), 0.8), 0.75, 0.25)",
+                frac("x", pu),
+                frac("y", pv)
+            ),
+            1.0,
         )),
         _ => None,
     }
+}
+
+/// The boundaries `z_0 < … < z_S` of the slices in planar depth, as
+/// [`SliceRange::index`] cuts them (equal steps in depth or in 1/depth).
+pub fn slice_boundaries(r: &SliceRange) -> Vec<f64> {
+    let n = r.count as f64;
+    (0..=r.count)
+        .map(|k| {
+            let s = k as f64 / n;
+            match r.spacing {
+                SliceSpacing::Depth => r.z_near + s * (r.z_far - r.z_near),
+                SliceSpacing::Disparity => {
+                    1.0 / (1.0 / r.z_near + s * (1.0 / r.z_far - 1.0 / r.z_near))
+                }
+            }
+        })
+        .collect()
+}
+
+/// One depth slice alone (the thesis' ground truth renders slice `k` by itself): every object
+/// is clipped to the planar-depth slab `[z_k, z_{k+1})` of the view's camera (the first and
+/// last slices extend to the camera and to infinity, as [`SliceRange::index`] clamps), shown
+/// white and unlit, with the transmittance `1 − opacity` (cut-outs: fully transmitting holes),
+/// so the output alpha (`+UA`) is the coverage of the slice's geometry: `1 − Π(1 − a)` over
+/// the surfaces a ray meets in the slab. Glass is left out (its coverage is its Fresnel
+/// reflectance, which a pigment cannot express); images' alpha gets its mean opacity.
+/// Render with `Declare=Slice=K -A +UA +FN16 File_Gamma=1.0`, at a multiple of the resolution
+/// for the pixel coverage.
+fn slice_scene(scene: &ExportScene) -> String {
+    let mut s = String::from(
+        "#version 3.7;\nglobal_settings { assumed_gamma 1.0 max_trace_level 256 adc_bailout 0 }\n",
+    );
+    s.push_str("#include \"cameras.inc\"\n#include \"geometry.inc\"\n");
+    s.push_str("#ifndef (Slice) #error \"declare the slice: Declare=Slice=K\" #end\n");
+    let r = &scene.desc.slices;
+    let z: Vec<String> = slice_boundaries(r).iter().map(f64::to_string).collect();
+    let _ = writeln!(
+        s,
+        "#declare SliceCount = {};\n#declare SliceZ = array[{}] {{ {} }}",
+        r.count,
+        z.len(),
+        z.join(", ")
+    );
+    s.push_str(
+        "#declare CamF = <CamFx, CamFy, CamFz>;\n\
+         #declare CamD = vdot(<CamOx, CamOy, CamOz>, CamF);\n\
+         #declare Near = (Slice = 0 ? -1e9 : SliceZ[Slice]);\n\
+         #declare Far = (Slice = SliceCount - 1 ? 1e9 : SliceZ[Slice + 1]);\n\
+         #declare SliceClip = intersection { plane { -CamF, -(Near + CamD) } plane { CamF, Far + CamD } }\n\
+         #declare SliceFinish = finish { emission 1 ambient 0 diffuse 0 specular 0 }\n",
+    );
+    for m in &scene.meshes {
+        let mat = scene.material(m);
+        if matches!(mat.model, SurfaceModel::Glass { .. }) {
+            continue;
+        }
+        let pigment = match cutout_shape(&mat.opacity) {
+            Some((pattern, a)) => format!(
+                "pigment_pattern {{ uv_mapping function {{ {pattern} }} }}\n    \
+                 pigment_map {{ [0 rgbt 1] [0.5 rgbt 1] [0.5 rgbt <1, 1, 1, {t}>] [1 rgbt <1, 1, 1, {t}>] }}",
+                t = 1.0 - a
+            ),
+            None => {
+                let a = mat.opacity.uniform();
+                format!(
+                    "rgbt <1, 1, 1, {}>",
+                    1.0 - a.unwrap_or_else(|| mean_opacity(&mat.opacity))
+                )
+            }
+        };
+        let _ = writeln!(
+            s,
+            "object {{ {} clipped_by {{ SliceClip }} texture {{ pigment {{ {pigment} }} finish {{ SliceFinish }} }} }}",
+            m.id
+        );
+    }
+    s
 }
 
 /// Colour scene for direct-light comparisons: mean base colours and opacities, Lambert
@@ -362,6 +457,30 @@ mod tests {
         // up × forward in POV-Ray's, i.e. POV-Ray's left-handed convention.
         let (r, u, f) = (to_pov(cam.right()), to_pov(cam.up), to_pov(cam.forward));
         assert!((r - u.cross(f)).length() < 1e-12);
+    }
+
+    /// Every slab `[z_k, z_{k+1})` of `slices.pov` is the set of depths lfgen puts in slice k.
+    #[test]
+    fn slice_boundaries_cut_where_the_slice_index_changes() {
+        for spacing in [SliceSpacing::Depth, SliceSpacing::Disparity] {
+            let r = SliceRange {
+                z_near: 1.3,
+                z_far: 9.7,
+                count: 128,
+                spacing,
+            };
+            let z = slice_boundaries(&r);
+            assert_eq!(z.len(), 129);
+            assert!((z[0] - 1.3).abs() < 1e-12 && (z[128] - 9.7).abs() < 1e-9);
+            for k in 0..128 {
+                let (a, b) = (z[k], z[k + 1]);
+                assert!(a < b);
+                for t in [1e-5, 0.5, 1.0 - 1e-5] {
+                    let inside = (a + t * (b - a)) as f32;
+                    assert_eq!(r.index(inside), k, "{spacing:?} slice {k}");
+                }
+            }
+        }
     }
 
     #[test]
