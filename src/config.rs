@@ -232,7 +232,7 @@ impl Default for SceneConfig {
             environment: [0.2, 0.22, 0.25],
             windows: [0, 2],
             door: 0.35,
-            window_light: [3.0, 10.0],
+            window_light: [2.0, 6.0],
             catalog: String::new(),
             catalog_share: 0.5,
             category_weights: std::collections::BTreeMap::new(),
