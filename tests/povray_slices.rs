@@ -536,6 +536,12 @@ fn slice_renders_composited_with_over_match_the_single_pass_ground_truth() {
 
     let tally = compare(&sample, &reference, &excluded);
     let surface_tally = compare(&surface, &reference, &excluded);
+    // What the exclusions hide: the excluded pixels compared alone.
+    let only_excluded: Vec<Option<usize>> = excluded
+        .iter()
+        .map(|e| e.map_or(Some(0), |_| None))
+        .collect();
+    let excluded_tally = compare(&sample, &reference, &only_excluded);
     let surface_diff = differences(&surface, &sample, &scene, &desc);
     let modes_per_pixel =
         sample.iter().flatten().filter(|&&e| e > TAU).count() as f64 / (WIDTH * HEIGHT) as f64;
@@ -556,6 +562,7 @@ fn slice_renders_composited_with_over_match_the_single_pass_ground_truth() {
     println!("lfgen    compared same-modes explained edge-free ef-|Δη|≤1e-4 mean-TV  failing");
     print_tally("sample", &tally);
     print_tally("surface", &surface_tally);
+    print_tally("excluded", &excluded_tally);
     println!(
         "surface differs from sample in {} pixels: {} with a surface crossing a slice boundary \
          inside the pixel, {} more with two faces of one object in different slices within 2 % \
