@@ -407,7 +407,7 @@ impl SceneConfig {
             bail!("scene.windows must be [min, max] with min <= max <= 4");
         }
         let [a, b] = self.window_light;
-        if !(0.0..=1.0).contains(&self.door) || !(a.is_finite() && 0.0 <= a && a <= b) {
+        if !((0.0..=1.0).contains(&self.door) && a.is_finite() && 0.0 <= a && a <= b) {
             bail!("scene.door must lie in [0, 1] and scene.window_light be a [min, max] range");
         }
         if !(0.0..=1.0).contains(&self.catalog_share) {

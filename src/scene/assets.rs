@@ -109,7 +109,7 @@ impl Assets {
 
 /// An opened source file of either format.
 pub enum Source {
-    Gltf(GltfFile),
+    Gltf(Box<GltfFile>),
     Obj(ObjFile),
 }
 
@@ -118,7 +118,7 @@ impl Source {
     pub fn open_unchanged(src: &SourceFile) -> Result<Self> {
         match src.path.to_ascii_lowercase().ends_with(".obj") {
             true => ObjFile::open_unchanged(src).map(Source::Obj),
-            false => GltfFile::open_unchanged(src).map(Source::Gltf),
+            false => GltfFile::open_unchanged(src).map(|f| Source::Gltf(Box::new(f))),
         }
     }
 

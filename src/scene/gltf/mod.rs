@@ -73,7 +73,7 @@ fn import_file(path: &Path, cfg: &Config) -> Result<Imported> {
         placement: None,
         sources: Vec::new(),
     };
-    let file = [Source::Gltf(file)];
+    let file = [Source::Gltf(Box::new(file))];
     let assets = Assets::from_files(&desc, &file)?;
     // After loading, so the checksums of every file read are recorded.
     desc.sources = vec![file[0].source_file()?];
