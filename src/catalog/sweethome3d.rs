@@ -998,33 +998,57 @@ fn statement(line: &[u8], keyword: &str) -> Option<String> {
 
 /// The archive file a reference (`mtllib`, `map_Kd` …) names, if it is a clean relative path
 /// ([`safe_relative`]) to a file of the archive: the whole argument, else its last word (map
-/// options such as `-s 1 1 1` come first). Absolute paths from the authors' disks
-/// (`C:/Documents and Settings/…`) and missing files give `None`.
-fn resolve(lib: &Library, dir: &str, arg: &str) -> Option<String> {
+/// options such as `-s 1 1 1` come first, and disk paths with blanks such as
+/// `/Users/x/Living room rug.jpg` end with the file's name). Other absolute paths from the
+/// authors' disks (`C:/Documents and Settings/…`) and missing files give `None`.
+fn resolve(lib: &Library, dir: &str, arg: &str) -> Option<Reference> {
     let last = arg.split_whitespace().last().unwrap_or("");
     [arg, last].into_iter().find_map(|a| {
         safe_relative(a)?;
-        join_zip(dir, a).filter(|n| lib.names.contains(n))
+        let name = join_zip(dir, a).filter(|n| lib.names.contains(n))?;
+        Some(Reference {
+            name,
+            path: a.to_string(),
+            whole: a == arg,
+        })
     })
 }
 
-/// `text` with the lines `bad` picks commented out (`# lfgen: missing: …`), or `None` when it
-/// picks none.
-fn comment_out(text: &[u8], bad: &HashSet<Vec<u8>>) -> Option<Vec<u8>> {
-    if bad.is_empty() {
+/// A file a reference names.
+struct Reference {
+    /// Its archive name.
+    name: String,
+    /// The path as written, relative to the referring file.
+    path: String,
+    /// Whether that is the whole argument (else its last word, after options or a disk path).
+    whole: bool,
+}
+
+/// `text` with the lines that are keys of `new` replaced by their values, or `None` when
+/// there are none.
+fn rewrite(text: &[u8], new: &HashMap<Vec<u8>, String>) -> Option<Vec<u8>> {
+    if new.is_empty() {
         return None;
     }
-    let mut out = Vec::with_capacity(text.len() + 64 * bad.len());
+    let mut out = Vec::with_capacity(text.len() + 64 * new.len());
     for (i, line) in text.split(|&b| b == b'\n').enumerate() {
         if i > 0 {
             out.push(b'\n');
         }
-        if bad.contains(line.strip_suffix(b"\r").unwrap_or(line)) {
-            out.extend_from_slice(b"# lfgen: file missing from the library: ");
+        match new.get(line.strip_suffix(b"\r").unwrap_or(line)) {
+            Some(replacement) => out.extend_from_slice(replacement.as_bytes()),
+            None => out.extend_from_slice(line),
         }
-        out.extend_from_slice(line);
     }
     Some(out)
+}
+
+/// A line commented out because the file it names is not in the library.
+fn missing_line(line: &[u8]) -> String {
+    format!(
+        "# lfgen: file missing from the library: {}",
+        String::from_utf8_lossy(line)
+    )
 }
 
 /// What the converter learnt of one OBJ and its materials.
@@ -1035,7 +1059,8 @@ struct ObjPlan {
     builtin: BTreeSet<String>,
     /// `.mtl` files and textures it needs (archive names).
     needs: BTreeSet<String>,
-    /// `.mtl` files rewritten with their references to missing textures commented out.
+    /// `.mtl` files rewritten: references to missing textures commented out, the others
+    /// reduced to the plain relative path (`map_Kd rug.jpg`, no options or disk path before it).
     patched: HashMap<String, Vec<u8>>,
     /// References to files absent from the library (or outside it).
     missing: usize,
@@ -1050,7 +1075,7 @@ fn plan_obj(lib: &mut Library, obj_name: &str, obj: &[u8], builtin_file: &str) -
         patched: HashMap::new(),
         missing: 0,
     };
-    let mut missing_libs = HashSet::new();
+    let mut missing_libs = HashMap::new();
     let mut defined = HashSet::new();
     let mut used = BTreeSet::new();
     for line in lines(obj) {
@@ -1061,8 +1086,8 @@ fn plan_obj(lib: &mut Library, obj_name: &str, obj: &[u8], builtin_file: &str) -
         let Some(arg) = statement(line, "mtllib") else {
             continue;
         };
-        let Some(mtl) = resolve(lib, &dir, &arg) else {
-            missing_libs.insert(line.to_vec());
+        let Some(Reference { name: mtl, .. }) = resolve(lib, &dir, &arg) else {
+            missing_libs.insert(line.to_vec(), missing_line(line));
             plan.missing += 1;
             continue;
         };
@@ -1070,29 +1095,33 @@ fn plan_obj(lib: &mut Library, obj_name: &str, obj: &[u8], builtin_file: &str) -
             continue;
         };
         let mtl_dir = parent_dir(&mtl).to_string();
-        let mut missing_maps = HashSet::new();
+        let mut new_lines = HashMap::new();
         for l in lines(&text) {
             if let Some(name) = statement(l, "newmtl") {
                 defined.insert(name);
             }
             let s = String::from_utf8_lossy(l);
             let mut it = s.trim_start().splitn(2, [' ', '\t']);
-            let key = it.next().unwrap_or("").to_ascii_lowercase();
-            let map = key.starts_with("map_")
-                || matches!(key.as_str(), "bump" | "disp" | "decal" | "refl");
+            let key = it.next().unwrap_or("");
+            let lower = key.to_ascii_lowercase();
+            let map = lower.starts_with("map_")
+                || matches!(lower.as_str(), "bump" | "disp" | "decal" | "refl");
             if let (true, Some(arg)) = (map, it.next()) {
                 match resolve(lib, &mtl_dir, arg.trim()) {
                     Some(file) => {
-                        plan.needs.insert(file);
+                        if !file.whole {
+                            new_lines.insert(l.to_vec(), format!("{key} {}", file.path));
+                        }
+                        plan.needs.insert(file.name);
                     }
                     None => {
-                        missing_maps.insert(l.to_vec());
+                        new_lines.insert(l.to_vec(), missing_line(l));
                         plan.missing += 1;
                     }
                 }
             }
         }
-        if let Some(patched) = comment_out(&text, &missing_maps) {
+        if let Some(patched) = rewrite(&text, &new_lines) {
             plan.patched.insert(mtl.clone(), patched);
         }
         plan.needs.insert(mtl);
@@ -1104,7 +1133,7 @@ fn plan_obj(lib: &mut Library, obj_name: &str, obj: &[u8], builtin_file: &str) -
                 .as_bytes(),
         );
     }
-    match comment_out(obj, &missing_libs) {
+    match rewrite(obj, &missing_libs) {
         Some(patched) => plan.obj.extend_from_slice(&patched),
         None => plan.obj.extend_from_slice(obj),
     }
@@ -1679,8 +1708,9 @@ mod tests {
             id#6=Test#evil\nname#6=Evil\ncategory#6=Kitchen\nmodel#6=/../evil.obj\n\
             width#6=60\ndepth#6=40\nheight#6=80\n";
         let chair_obj = "mtllib chair.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl wood\nf 1 2 3\n";
-        let chair_mtl =
-            "newmtl wood\nKd 0.5 0.3 0.1\nmap_Kd wood.png\nmap_Ks C:/Users/me/spec.jpg\n";
+        let chair_mtl = "newmtl wood\nKd 0.5 0.3 0.1\nmap_Kd wood.png\n\
+                         map_Ks C:/Users/me/spec.jpg\nmap_Bump -bm 0.03 wood.png\n\
+                         map_Ka /Users/me/My wood.png\n";
         let cab_obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl glass\nf 1 2 3\nusemtl white\nf 1 3 2\n";
         {
             let mut zip = zip::ZipWriter::new(fs::File::create(&archive).unwrap());
@@ -1762,6 +1792,12 @@ mod tests {
             mtl.contains("\n# lfgen: file missing from the library: map_Ks C:/Users/me/spec.jpg\n")
         );
         assert!(mtl.contains("\nmap_Kd wood.png\n"));
+        // Options and disk paths in front of a file of the folder are dropped (tobj reads the
+        // whole rest of the line as the path).
+        assert!(
+            mtl.contains("\nmap_Bump wood.png\nmap_Ka wood.png\n"),
+            "{mtl}"
+        );
         assert_eq!(summary.missing_files, 1);
 
         let cab = &assets[1];
