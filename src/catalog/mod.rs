@@ -211,7 +211,8 @@ mod tests {
         let json = serde_json::to_string_pretty(&c).unwrap();
         assert_eq!(serde_json::from_str::<Catalog>(&json).unwrap(), c);
         assert_eq!(asset().problem(), None);
-        let cases: [(fn(&mut Asset), &str); 5] = [
+        type Edit = fn(&mut Asset);
+        let cases: [(Edit, &str); 5] = [
             (|a| a.size[0] = 0.0, "size"),
             (|a| a.size[1] = f32::NAN, "size"),
             (|a| a.file = "../x.obj".into(), "not a relative path"),
