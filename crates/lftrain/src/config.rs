@@ -152,6 +152,17 @@ pub struct TrainConfig {
     pub steps: usize,
     /// Adam learning rate (thesis: 1e-3).
     pub learning_rate: f64,
+    /// Steps after which the learning rate is multiplied by `lr_decay` (each one once; empty:
+    /// constant, the thesis' posterior models). E.g. `[3000]` with `lr_decay = 0.01`: 1e-3 for
+    /// steps 1..=3000, 1e-5 after (the 1e-4 → 1e-5 drop of thesis §4.2.5).
+    pub lr_decay_steps: Vec<usize>,
+    /// Factor applied at each of `lr_decay_steps`.
+    pub lr_decay: f64,
+    /// From this step on, batch norm is frozen: running statistics instead of batch
+    /// statistics, neither they nor γ, β are trained any more (thesis §4.2.5 "fixed the learned
+    /// BN parameters" with the learning-rate drop). Left out: never.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub freeze_bn_after: Option<usize>,
     /// Modes kept per pixel for multimodal targets (the thesis' loader: 12).
     pub max_modes: usize,
     /// Validate every this many steps (0: only at the end).
@@ -183,6 +194,9 @@ impl Default for TrainConfig {
             batch: 16,
             steps: 10_000,
             learning_rate: 1e-3,
+            lr_decay_steps: Vec::new(),
+            lr_decay: 0.1,
+            freeze_bn_after: None,
             max_modes: 12,
             val_every: 500,
             checkpoint_every: 500,
@@ -229,11 +243,65 @@ impl TrainConfig {
         if self.ese.members == 0 || self.ese.members.is_multiple_of(2) || self.ese.delta <= 0.0 {
             bail!("ese.members must be odd and ese.delta positive");
         }
+        if !(self.learning_rate > 0.0 && self.lr_decay > 0.0) {
+            bail!("learning_rate and lr_decay must be positive");
+        }
         Ok(())
+    }
+
+    /// The learning rate of the optimiser step that follows `done` finished steps (steps are
+    /// counted from 1: with `lr_decay_steps = [s]`, steps 1..=s use `learning_rate`).
+    pub fn learning_rate_after(&self, done: usize) -> f64 {
+        let drops = self.lr_decay_steps.iter().filter(|&&s| done >= s).count();
+        self.learning_rate * self.lr_decay.powi(drops as i32)
+    }
+
+    /// Whether batch norm is frozen for the step that follows `done` finished steps.
+    pub fn bn_frozen_after(&self, done: usize) -> bool {
+        self.freeze_bn_after.is_some_and(|s| done >= s)
     }
 
     /// Modes per pixel in the targets: all (up to `max_modes`) or only the front-most.
     pub fn target_modes(&self) -> usize {
         if self.multimodal { self.max_modes } else { 1 }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_is_the_thesis_constant_rate_without_freezing() {
+        let cfg = TrainConfig::default();
+        for done in [0, 1, 5_000, 1_000_000] {
+            assert_eq!(cfg.learning_rate_after(done), 1e-3);
+            assert!(!cfg.bn_frozen_after(done));
+        }
+        let text = toml::to_string_pretty(&cfg).unwrap();
+        assert!(!text.contains("freeze_bn_after"));
+        let back: TrainConfig = toml::from_str(&text).unwrap();
+        assert_eq!(back, cfg);
+    }
+
+    #[test]
+    fn step_decay_and_freezing_from_toml() {
+        let cfg: TrainConfig = toml::from_str(
+            "learning_rate = 1e-3\nlr_decay_steps = [100, 300]\nlr_decay = 0.1\nfreeze_bn_after = 100\n",
+        )
+        .unwrap();
+        cfg.validate().unwrap();
+        let lr = |d| cfg.learning_rate_after(d);
+        assert_eq!(lr(0), 1e-3);
+        assert_eq!(lr(99), 1e-3);
+        assert!((lr(100) - 1e-4).abs() < 1e-12);
+        assert!((lr(299) - 1e-4).abs() < 1e-12);
+        assert!((lr(300) - 1e-5).abs() < 1e-13);
+        assert!(!cfg.bn_frozen_after(99));
+        assert!(cfg.bn_frozen_after(100));
+        let back: TrainConfig = toml::from_str(&toml::to_string_pretty(&cfg).unwrap()).unwrap();
+        assert_eq!(back, cfg);
+        let bad: TrainConfig = toml::from_str("lr_decay = 0.0").unwrap();
+        assert!(bad.validate().is_err());
     }
 }

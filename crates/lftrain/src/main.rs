@@ -8,7 +8,7 @@ use clap::{Args, Parser, Subcommand};
 use lftrain::config::{ModelKind, TrainConfig};
 use lftrain::loader::PoolConfig;
 use lftrain::predict::predict_dataset;
-use lftrain::train::{TrainArgs, bench_steps, train};
+use lftrain::train::{TrainArgs, bench_loader, bench_steps, train};
 
 #[derive(Parser)]
 #[command(
@@ -40,7 +40,8 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
-    /// Seconds per training step of a configuration on random input (no data loading).
+    /// Seconds per training step of a configuration on random input (no data loading), or
+    /// with --loader the crops/s of the data loader alone.
     Bench {
         /// TOML config (network, batch, patch, model).
         #[arg(long)]
@@ -54,6 +55,18 @@ enum Command {
         /// Timed steps (after one warm-up step).
         #[arg(long, default_value_t = 5)]
         steps: usize,
+        /// Time the data loader alone on this dataset instead (crops/s, no training).
+        #[arg(long)]
+        loader: Option<PathBuf>,
+        /// Timed batches of --loader (after the first).
+        #[arg(long, default_value_t = 50)]
+        batches: usize,
+        /// Scenes held in memory by the loader (--loader).
+        #[arg(long, default_value_t = 16)]
+        scene_pool: usize,
+        /// Batches between two scene replacements (--loader).
+        #[arg(long, default_value_t = 8)]
+        pool_refresh: usize,
     },
 }
 
@@ -142,6 +155,10 @@ fn run(cli: Cli) -> Result<()> {
             model,
             grid,
             steps,
+            loader,
+            batches,
+            scene_pool,
+            pool_refresh,
         } => {
             let mut cfg = match &config {
                 Some(path) => TrainConfig::read(path)?,
@@ -149,6 +166,23 @@ fn run(cli: Cli) -> Result<()> {
             };
             if let Some(m) = model {
                 cfg.model = m;
+            }
+            if let Some(dataset) = loader {
+                let pool = PoolConfig {
+                    scenes: scene_pool,
+                    refresh: pool_refresh,
+                };
+                let (first, crops) = bench_loader(&cfg, &dataset, pool, batches)?;
+                println!(
+                    "loader ({} threads): batch {} of {}x{} crops: first batch after {first:.2} s, \
+                     then {crops:.1} crops/s ({:.3} s per batch) over {batches} batches",
+                    rayon::current_num_threads(),
+                    cfg.batch,
+                    cfg.patch,
+                    cfg.patch,
+                    cfg.batch as f64 / crops
+                );
+                return Ok(());
             }
             let (s, params) = bench_steps(&cfg, grid, steps)?;
             println!(

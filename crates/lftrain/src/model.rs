@@ -40,6 +40,14 @@ impl Block {
         }
     }
 
+    /// The block with its batch norm frozen (running statistics, no trained γ, β).
+    pub fn freeze_batch_norm(self) -> Self {
+        Self {
+            norm: self.norm.freeze(),
+            ..self
+        }
+    }
+
     /// Same spatial size out as in.
     pub fn forward(&self, x: Tensor<4>) -> Tensor<4> {
         let x = relu(self.first.forward(x));
@@ -105,6 +113,18 @@ impl EpiNet {
             head: blocks(4 * streams_out, cfg.head_width, cfg.head_blocks, device),
             last_first: conv2x2(head_out, out, true, device),
             last_second: conv2x2(out, out, false, device),
+        }
+    }
+
+    /// The network with every batch norm frozen: from then on, training steps normalise with
+    /// the running statistics (as inference does) and update neither them nor γ, β.
+    pub fn freeze_batch_norm(self) -> Self {
+        let freeze = |v: Vec<Block>| v.into_iter().map(Block::freeze_batch_norm).collect();
+        Self {
+            straight: freeze(self.straight),
+            diagonal: freeze(self.diagonal),
+            head: freeze(self.head),
+            ..self
         }
     }
 

@@ -106,6 +106,7 @@ pub fn train(mut cfg: TrainConfig, args: &TrainArgs) -> Result<TrainSummary> {
         device,
         base,
         state: RunState { grid, ..state },
+        bn_frozen: false,
     };
     trainer.run(&loader, &val, &mut log, &run, args.quiet)
 }
@@ -118,6 +119,8 @@ struct Trainer {
     device: Device,
     base: Device,
     state: RunState,
+    /// Whether `net`'s batch norms have been frozen (`freeze_bn_after`).
+    bn_frozen: bool,
 }
 
 impl Trainer {
@@ -134,6 +137,19 @@ impl Trainer {
         let start = Instant::now();
         let (first, mut last_val) = (self.state.step, None);
         while self.state.step < self.cfg.steps {
+            let done = self.state.step;
+            if done > 0
+                && self.cfg.learning_rate_after(done) != self.cfg.learning_rate_after(done - 1)
+            {
+                bar.println(format!(
+                    "step {}: learning rate {:e}",
+                    done + 1,
+                    self.cfg.learning_rate_after(done)
+                ));
+            }
+            if self.cfg.bn_frozen_after(done) && !self.bn_frozen {
+                bar.println(format!("step {}: batch norm frozen", done + 1));
+            }
             let t0 = Instant::now();
             let batch = loader.next_batch()?;
             let loss = self.step(&batch)?;
@@ -182,6 +198,11 @@ impl Trainer {
 
     /// One Adam step on `batch`; returns its loss.
     fn step(&mut self, batch: &crate::sample::Batch) -> Result<f64> {
+        let done = self.state.step;
+        if self.cfg.bn_frozen_after(done) && !self.bn_frozen {
+            self.net = self.net.clone().freeze_batch_norm();
+            self.bn_frozen = true;
+        }
         let stacks = stack_tensors(batch, &self.device);
         let targets = target_tensors(batch, &self.cfg, &self.device);
         let out = self.net.forward(stacks);
@@ -192,7 +213,9 @@ impl Trainer {
         }
         let grads = GradientsParams::from_grads(loss.backward(), &self.net);
         let net = self.net.clone();
-        self.net = self.optim.step(self.cfg.learning_rate, net, grads);
+        self.net = self
+            .optim
+            .step(self.cfg.learning_rate_after(done), net, grads);
         Ok(value)
     }
 }
@@ -251,6 +274,7 @@ pub fn bench_steps(cfg: &TrainConfig, grid: usize, steps: usize) -> Result<(f64,
         device,
         base,
         state: RunState::default(),
+        bn_frozen: false,
     };
     trainer.step(&batch)?;
     let start = Instant::now();
@@ -259,4 +283,27 @@ pub fn bench_steps(cfg: &TrainConfig, grid: usize, steps: usize) -> Result<(f64,
     }
     let seconds = start.elapsed().as_secs_f64() / steps.max(1) as f64;
     Ok((seconds, trainer.net.num_params()))
+}
+
+/// Throughput of the data pipeline alone: the [`Loader`] (background thread, rayon workers)
+/// on `dataset` with `cfg`'s batch, patch and augmentations, nobody training. Returns the
+/// seconds until the first batch (pool loading included) and crops per second over the next
+/// `batches` batches.
+pub fn bench_loader(
+    cfg: &TrainConfig,
+    dataset: &std::path::Path,
+    pool: PoolConfig,
+    batches: usize,
+) -> Result<(f64, f64)> {
+    let scenes = discover(dataset, &[])?;
+    let start = Instant::now();
+    let loader = Loader::start(scenes, cfg.clone(), pool, 0)?;
+    loader.next_batch()?;
+    let first = start.elapsed().as_secs_f64();
+    let t0 = Instant::now();
+    let mut crops = 0;
+    for _ in 0..batches {
+        crops += loader.next_batch()?.size;
+    }
+    Ok((first, crops as f64 / t0.elapsed().as_secs_f64()))
 }

@@ -313,3 +313,46 @@ fn every_model_writes_a_posterior_lfeval_reads() {
         }
     }
 }
+
+#[test]
+fn frozen_batch_norm_trains_like_inference_and_keeps_its_statistics() {
+    let dev = device().autodiff();
+    dev.seed(5);
+    let net = EpiNet::new(&tiny_net(), 9, 1, &dev);
+    let shape = [2, 9, 6, 6];
+    let input: Vec<f32> = (0..2 * 9 * 36)
+        .map(|i| ((i * 53 % 97) as f32) / 97.0)
+        .collect();
+    let stacks = || std::array::from_fn(|_| tensor4(input.clone(), shape, &dev));
+    // A few training-mode passes move the running statistics away from (0, 1), so that
+    // inference differs from the batch-statistics path.
+    for _ in 0..3 {
+        let _ = net.forward(stacks());
+    }
+    let trained = values(net.forward(stacks()));
+    let frozen = net.clone().freeze_batch_norm();
+    let inference = values(net.valid().forward(std::array::from_fn(|_| {
+        tensor4(input.clone(), shape, &device())
+    })));
+    let out = frozen.forward(stacks());
+    let frozen_out = values(out.clone());
+    let close = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-4);
+    assert!(close(&frozen_out, &inference), "frozen ≠ inference");
+    assert!(
+        !close(&trained, &inference),
+        "batch statistics should differ"
+    );
+    // Gradients still reach the convolutions, not batch norm's γ, β; the running statistics
+    // stay where they were.
+    let before = values(frozen.valid().forward(std::array::from_fn(|_| {
+        tensor4(input.clone(), shape, &device())
+    })));
+    let grads = out.sum().backward();
+    let params = burn::optim::GradientsParams::from_grads(grads, &frozen);
+    assert!(!params.is_empty());
+    let _ = frozen.forward(stacks());
+    let after = values(frozen.valid().forward(std::array::from_fn(|_| {
+        tensor4(input.clone(), shape, &device())
+    })));
+    assert!(close(&before, &after), "frozen statistics moved");
+}
