@@ -1,9 +1,15 @@
-"""lfgen against Mitsuba 3 and Blender Cycles (README, "Validation"); driven by validate.sh.
+"""lfgen against Mitsuba 3, Blender Cycles and POV-Ray (README, "Validation"); driven by
+validate.sh.
 
 Subcommands:
-  depth   SCENE_DIR MITSUBA_DIR [--blender BLENDER_DIR]   planar depth vs gt_depth_lowres_CamNNN.pfm
-  match   SCENE_JSON BLENDER_JSON OUT_JSON                 the colour-matched scene (see below)
-  colour  LFGEN_EXR MITSUBA_DIR [--blender BLENDER_DIR]   colour vs lfgen's linear EXR, timings
+  depth     SCENE_DIR MITSUBA_DIR [--blender BLENDER_DIR]  planar depth vs gt_depth_lowres_CamNNN.pfm
+  match     SCENE_JSON BLENDER_JSON OUT_JSON [--diffuse] [--roughness R] [--metallic M] ...
+                                                           the colour-matched scene (see below)
+  colour    LFGEN_EXR LFGEN_SECONDS [--mitsuba DIR [--variants V,..] [--lfgen-bsdf]]
+            [--blender DIR] [--pov DIR]                    colour vs lfgen's linear EXR, timings
+  povdirect POV_DIR BLENDER_DIR                            direct.pov: lfgen's direct light in POV-Ray
+  timed     OUT COMMAND...                                 "wall cpu" seconds of a command
+  mitsuba-render XML OUT.npy [--variant V] [--spp N]      one Mitsuba render (lfgen_standard registered)
 
 Depth: Mitsuba renders the `position` AOV with one non-jittered stratified sample (the pixel
 centre) and planar depth is (p - o)·forward; Blender's Z pass at 1 spp is planar depth of the
@@ -11,8 +17,12 @@ pixel-centre sample. Only surfaces lfgen's HCI depth counts are present (the exp
 them). Pixels next to a depth discontinuity in lfgen's map (silhouettes) are reported apart.
 
 Colour: renderers differ in textures, so `match` rewrites scene.json with every base colour and
-opacity replaced by the uniform means the exporters give other renderers; lfgen re-renders that
-scene and both references render the same export at the same spp and bounce limit.
+opacity replaced by the uniform means the exporters give other renderers (`--diffuse`: every
+material lfgen's Lambert-only `diffuse` model, which Mitsuba and Cycles have exactly); lfgen
+re-renders that scene and the references render the same export at the same spp and bounce
+limit. With `--lfgen-bsdf` Mitsuba renders lfgen's own Standard BSDF (scripts/lfgen_bsdf.py)
+instead of `principled`. Metric: per 8×8 block the mean over pixels and channels, relative to
+lfgen; mean, 90th percentile, and the ratio of the totals.
 """
 
 import argparse
@@ -212,7 +222,10 @@ def cmd_colour(a):
     print(f"| lfgen | {a.lfgen_bsdf_name} | {a.spp} | – | – | – | {lf_time:.1f} s | 1 "
           f"| {lf_cpu:.1f} s | 1 |")
 
+    refs = {}
+
     def row(name, bsdf, img, t, cpu):
+        refs[name] = img
         mean, p90, energy = block_stats(ref, img)
         print(f"| {name} | {bsdf} | {a.spp} | {100 * mean:.2f} % | {100 * p90:.2f} % | "
               f"{100 * energy:+.2f} % | {t:.1f} s | {lf_time / t:.2f} | {cpu:.1f} s "
@@ -249,6 +262,12 @@ def cmd_colour(a):
         img = render_pov_direct(a.pov, 0, w, h, a.pov_supersample, out)
         row(f"POV-Ray 3.7 ({a.pov_supersample}² rays/px)", "Lambert, point-light grid", img,
             time.time() - t0, children_cpu() - c0)
+    # The references against each other (the first one as the reference).
+    names = list(refs)
+    for other in names[1:]:
+        mean, p90, energy = block_stats(refs[names[0]], refs[other])
+        print(f"\n{other} against {names[0]}: mean {100 * mean:.2f} %, p90 {100 * p90:.2f} %, "
+              f"energy {100 * energy:+.2f} %")
 
 
 def children_cpu():
@@ -326,6 +345,7 @@ def cmd_povdirect(a):
     exported mean colour, `diffuse 1/π` (POV-Ray's diffuse term is k·colour·I·cos θ, so the
     radiance is albedo/π · E as lfgen's), `ambient 0`, no specular, no radiosity; emitters
     show their emission and cast no shadow (lfgen's shadow rays stop short of the light).
+    Punctual lights are not written (the built-in scenes have none).
     """
     data = json.load(open(os.path.join(a.blender, "blender_scene.json")))
     mats = data["materials"]
