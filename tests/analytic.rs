@@ -653,3 +653,49 @@ fn gt_with_shaded_slices_renders_identical_images() {
         "colour differs when every GT hit is shaded"
     );
 }
+
+/// Direct light on a Lambert plane from a square emitter of radiance `L` facing it: the plane
+/// sends `ρ·L·F` back, `F` the point-to-rectangle form factor (closed form). With one bounce the
+/// light sample is the only estimate of it, so a path tracer that MIS-weights that sample
+/// against a BSDF ray it never follows comes out dark (lfgen did, by 7 %, until this test).
+#[test]
+fn direct_light_on_a_lambert_plane_matches_the_form_factor() {
+    let (rho, radiance, half, h) = (0.5f32, 4.0f32, 1.0f64, 2.5f64);
+    let cam = camera([32, 32], [1, 1], 100.0, DVec3::ZERO);
+    let plane = Material {
+        model: SurfaceModel::Diffuse,
+        ..matte([rho; 3], 1.0)
+    };
+    // The emitter hangs behind the camera, facing the plane (one-sided: the camera rays
+    // leave through its back).
+    let mut light = quad(
+        [2.0 * half as f32; 2],
+        Vec3::new(0.0, 0.0, 0.5),
+        emitter([radiance; 3]),
+    );
+    light.transform.rotation = Quat::from_rotation_y(std::f32::consts::PI);
+    let parts = vec![quad([20.0, 20.0], Vec3::new(0.0, 0.0, -2.0), plane), light];
+    let harness = Harness::new(scene(cam, [1.0, 5.0], [0.0; 3], parts));
+    let out = harness.render(0, &settings(256, 1), false);
+    // Form factor from a point to a parallel rectangle centred above it: four corner terms.
+    let (x, y) = (half / h, half / h);
+    let corner = |x: f64, y: f64| {
+        let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
+        (x / sx * (y / sx).atan() + y / sy * (x / sy).atan()) / (2.0 * std::f64::consts::PI)
+    };
+    let expected = rho as f64 * radiance as f64 * 4.0 * corner(x, y);
+    // The centre 8×8 pixels see the plane within 2 cm of the axis, where the form factor
+    // changes by less than 1e-4 relative.
+    let img = &out.image;
+    let mut sum = 0.0;
+    for j in 12..20 {
+        for i in 12..20 {
+            sum += img.pixels[j * img.width + i].x as f64;
+        }
+    }
+    let mean = sum / 64.0;
+    assert!(
+        (mean / expected - 1.0).abs() < 0.01,
+        "{mean} vs the closed form {expected}"
+    );
+}

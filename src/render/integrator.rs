@@ -56,11 +56,18 @@ impl RenderScene {
             let wo = -dir.normalize();
             let frame = Frame::from_normal(self.shading_normal(&h, wo, mat.glass_ior.is_some()));
             let wo_l = frame.to_local(wo);
+            // At the last vertex no BSDF-sampled ray follows to pick up the other MIS share of
+            // the direct light, so the light sample takes all of it (and the ray is not traced).
+            let last = depth + 1 == settings.max_depth;
             if !bsdf.is_delta() && !self.lights.is_empty() {
-                radiance += beta * self.direct_light(p, &h, &frame, wo_l, &bsdf, sampler);
+                let ld = self.direct_light(p, &h, &frame, wo_l, &bsdf, last, sampler);
+                radiance += beta * ld;
             }
             if !bsdf.is_delta() && !self.punctual_lights.is_empty() {
                 radiance += beta * self.punctual_light(p, &h, &frame, wo_l, &bsdf);
+            }
+            if last {
+                break;
             }
             let Some(bs) = bsdf.sample(wo_l, sampler.next_f32(), sampler.next2()) else {
                 break;
@@ -113,7 +120,9 @@ impl RenderScene {
         mat.emission * power_heuristic(arrival.pdf, light_pdf)
     }
 
-    /// One light sample with a shadow ray through semi-transparent surfaces.
+    /// One light sample with a shadow ray through semi-transparent surfaces, MIS-weighted
+    /// against BSDF sampling unless `alone` (no BSDF sample follows).
+    #[allow(clippy::too_many_arguments)]
     fn direct_light(
         &self,
         p: Vec3,
@@ -121,6 +130,7 @@ impl RenderScene {
         frame: &Frame,
         wo_l: Vec3,
         bsdf: &super::bsdf::SurfaceParams,
+        alone: bool,
         sampler: &mut Sampler,
     ) -> Vec3 {
         let ls = self.lights.sample(
@@ -150,7 +160,11 @@ impl RenderScene {
             return Vec3::ZERO;
         }
         let light_pdf = ls.pdf_area * dist * dist / cos_light;
-        f * ls.emission * (tr * wi_l.z.abs() * power_heuristic(light_pdf, bsdf_pdf) / light_pdf)
+        let weight = match alone {
+            true => 1.0,
+            false => power_heuristic(light_pdf, bsdf_pdf),
+        };
+        f * ls.emission * (tr * wi_l.z.abs() * weight / light_pdf)
     }
 
     /// Light from every punctual light, each with a shadow ray through semi-transparent
