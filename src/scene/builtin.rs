@@ -737,7 +737,13 @@ impl Gen<'_> {
     /// them by catalogue weight — and places them: floor and wall pieces first, then
     /// accessories on their surfaces.
     fn furnish(&mut self, room: Vec3, cam: &LightFieldCamera) -> PlacementReport {
-        let mut picks: Vec<Pick> = (0..self.cfg.scene.objects).map(|_| self.pick()).collect();
+        let kinds: Vec<f32> = Kind::ALL.iter().map(|k| k.weight()).collect();
+        let assets = self
+            .library
+            .map(|lib| lib.weights(&self.cfg.scene.category_weights));
+        let mut picks: Vec<Pick> = (0..self.cfg.scene.objects)
+            .map(|_| self.pick(&kinds, assets.as_deref()))
+            .collect();
         picks.sort_by_key(|&p| self.placement_of(p) == Placement::OnTop);
         let view = View::of(cam, room);
         let mut layout = Layout::new(room);
@@ -771,15 +777,15 @@ impl Gen<'_> {
 
     /// Draws what fills one furniture slot. Without a library the draws are exactly those of
     /// the procedural generator alone.
-    fn pick(&mut self) -> Pick {
-        if let Some(lib) = self.library
+    /// `kinds` and `assets` are the weights of the procedural kinds and of the library's
+    /// entries (computed once per scene).
+    fn pick(&mut self, kinds: &[f32], assets: Option<&[f32]>) -> Pick {
+        if let Some(weights) = assets
             && self.chance(self.cfg.scene.catalog_share)
         {
-            let weights = lib.weights(&self.cfg.scene.category_weights);
-            return Pick::Asset(self.weighted(&weights).unwrap_or(0));
+            return Pick::Asset(self.weighted(weights).unwrap_or(0));
         }
-        let weights: Vec<f32> = Kind::ALL.iter().map(|k| k.weight()).collect();
-        Pick::Kind(Kind::ALL[self.weighted(&weights).unwrap_or(Kind::ALL.len() - 1)])
+        Pick::Kind(Kind::ALL[self.weighted(kinds).unwrap_or(Kind::ALL.len() - 1)])
     }
 
     /// An index drawn with probability proportional to `weights` (`None`: all zero).

@@ -106,6 +106,10 @@ impl AssetLibrary {
     pub fn piece(&self, i: usize, source: u32, material: &mut dyn FnMut(Material) -> u32) -> Piece {
         let r = &self.assets[i];
         let a = &r.asset;
+        let elevation = match a.placement {
+            AssetPlacement::WallHung => a.elevation,
+            _ => 0.0,
+        };
         let mut ids: BTreeMap<Option<usize>, u32> = BTreeMap::new();
         let mut parts = Vec::with_capacity(r.meshes.len());
         for (mesh, &m) in r.meshes.iter().enumerate() {
@@ -120,10 +124,6 @@ impl AssetLibrary {
                 uv_set: 0,
                 matrix: r.matrix,
             };
-            let elevation = match a.placement {
-                AssetPlacement::WallHung => a.elevation,
-                _ => 0.0,
-            };
             parts.push(Part {
                 name: "mesh",
                 shape,
@@ -132,7 +132,6 @@ impl AssetLibrary {
             });
         }
         let half = Vec2::new(a.size[0], a.size[2]) / 2.0;
-        let elevation = parts[0].transform.translation.y;
         let surfaces = (a.surfaces.iter())
             .map(|&y| Surface {
                 y: elevation + y,

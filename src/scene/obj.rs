@@ -331,7 +331,8 @@ fn map_file(statement: &str) -> &str {
 }
 
 /// Refuses what would make the renderer misbehave: too many triangles, non-finite
-/// coordinates, dangling material ids, no geometry at all.
+/// coordinates, dangling material ids, no geometry at all (`tobj` already refuses face indices
+/// out of bounds).
 fn check_models(models: &[tobj::Model], materials: usize) -> Result<()> {
     let mut triangles = 0;
     for m in models {
@@ -350,12 +351,6 @@ fn check_models(models: &[tobj::Model], materials: usize) -> Result<()> {
                 .chain(&mesh.texcoords)
                 .all(|v| v.is_finite()),
             "{}: a normal or texture coordinate is not a finite number",
-            what()
-        );
-        let n = (mesh.positions.len() / 3) as u32;
-        ensure!(
-            mesh.indices.iter().all(|&i| i < n),
-            "{}: a face refers to a missing vertex",
             what()
         );
         if let Some(id) = mesh.material_id {
