@@ -205,7 +205,7 @@ fn lathe(profile: &[[f32; 2]], segments: u32, out: &mut Vec<MeshTri>) {
             Some(*s)
         }))
         .collect();
-    // Outward 2-D normal (radius, height) of each profile edge, averaged at shared points.
+    // Outward 2-D normal (radius, height) of each profile edge.
     let edge_n: Vec<Vec2> = p
         .windows(2)
         .map(|w| {
@@ -213,25 +213,35 @@ fn lathe(profile: &[[f32; 2]], segments: u32, out: &mut Vec<MeshTri>) {
             Vec2::new(d.y, -d.x).normalize_or_zero()
         })
         .collect();
-    let point_n = |i: usize| {
-        let a = edge_n[i.saturating_sub(1).min(edge_n.len() - 1)];
-        let b = edge_n[i.min(edge_n.len() - 1)];
-        (a + b).normalize_or(b)
+    // The normal at point `i` of edge `k`: averaged with the neighbouring edge's where the
+    // profile bends gently (a curve sampled in points), the edge's own across a crease (a rim,
+    // a step), where an average would tilt both faces' shading far from their geometry.
+    let point_n = |i: usize, k: usize| {
+        let other = if i == k { i.checked_sub(1) } else { Some(i) };
+        match other.and_then(|o| edge_n.get(o)) {
+            Some(&o) if o.dot(edge_n[k]) >= CREASE_COS => (o + edge_n[k]).normalize_or(edge_n[k]),
+            _ => edge_n[k],
+        }
     };
-    let last = p.len() - 1;
-    // Rows run down the profile (as the cylinder's side), which makes the winding outward.
-    let f = |i: u32, j: u32| {
-        let phi = TAU * j as f32 / segments as f32;
-        let (s, c) = phi.sin_cos();
-        let k = last - i as usize;
-        let (q, n2) = (p[k], point_n(k));
-        let pos = Vec3::new(q.x * c, q.y, -q.x * s);
-        let n = Vec3::new(n2.x * c, n2.y, -n2.x * s).normalize_or(Vec3::Y);
-        let uv = Vec2::new(phi * q.x.abs().max(0.01), arc[k]);
-        (pos, n, uv)
-    };
-    grid_mesh(p.len() as u32 - 1, segments, f, out);
+    // One band per profile edge, its rows running down the profile (as the cylinder's side),
+    // which makes the winding outward.
+    for k in 0..p.len() - 1 {
+        let f = |i: u32, j: u32| {
+            let phi = TAU * j as f32 / segments as f32;
+            let (s, c) = phi.sin_cos();
+            let at = k + 1 - i as usize;
+            let (q, n2) = (p[at], point_n(at, k));
+            let pos = Vec3::new(q.x * c, q.y, -q.x * s);
+            let n = Vec3::new(n2.x * c, n2.y, -n2.x * s).normalize_or(Vec3::Y);
+            let uv = Vec2::new(phi * q.x.abs().max(0.01), arc[at]);
+            (pos, n, uv)
+        };
+        grid_mesh(1, segments, f, out);
+    }
 }
+
+/// Cosine of the largest bend between two lathe profile edges that still shades smoothly (40°).
+const CREASE_COS: f32 = 0.766;
 
 /// Triangulates a `rows × cols` parametric patch; `f(i, j)` gives position, normal and UV.
 /// Degenerate triangles (at the poles) are skipped.
@@ -246,7 +256,7 @@ fn grid_mesh(
             let v = [f(i, j), f(i + 1, j), f(i + 1, j + 1), f(i, j + 1)];
             for [a, b, c] in [[0, 1, 2], [0, 2, 3]] {
                 let p = [v[a].0, v[b].0, v[c].0];
-                if (p[1] - p[0]).cross(p[2] - p[0]).length_squared() > 1e-12 {
+                if !is_sliver(&p) {
                     out.push(MeshTri {
                         p,
                         n: [v[a].1, v[b].1, v[c].1],
@@ -256,6 +266,18 @@ fn grid_mesh(
             }
         }
     }
+}
+
+/// Whether a triangle is degenerate: a pole of a sphere or lathe collapses one edge of its
+/// grid cells. The test is relative to the triangle's size (twice its area against its
+/// longest edge squared, ~ the sine of its widest angle), so small objects keep every face.
+fn is_sliver(p: &[Vec3; 3]) -> bool {
+    let (e0, e1, e2) = (p[1] - p[0], p[2] - p[0], p[2] - p[1]);
+    let longest = e0
+        .length_squared()
+        .max(e1.length_squared())
+        .max(e2.length_squared());
+    e0.cross(e1).length() <= 1e-6 * longest
 }
 
 #[cfg(test)]
@@ -293,6 +315,16 @@ mod tests {
             segments: 128,
         }));
         assert!((v - 4.0 / 3.0 * PI).abs() < 0.01, "{v}");
+        // A finely tessellated lamp bulb keeps every face but the collapsed ones at the poles
+        // (an absolute area threshold once dropped its faces near the poles, or all of them).
+        let bulb = tris(Shape::Sphere {
+            radius: 0.01,
+            rings: 96,
+            segments: 192,
+        });
+        assert_eq!(bulb.len(), 2 * 96 * 192 - 2 * 192);
+        let v = volume(&bulb);
+        assert!((v / (4.0 / 3.0 * PI * 1e-6) - 1.0).abs() < 1e-3, "{v}");
         let v = volume(&tris(Shape::Cylinder {
             radius: 0.5,
             height: 2.0,
@@ -334,6 +366,38 @@ mod tests {
             for t in tris(shape.clone()) {
                 let ng = (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]);
                 assert!(ng.dot(t.n[0] + t.n[1] + t.n[2]) > 0.0, "{shape:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn lathe_normals_are_smooth_along_curves_and_split_at_creases() {
+        let segments = 32;
+        let tol = (PI / segments as f32).cos() - 1e-4;
+        // A cylinder's side and its flat top meet at 90°: each face keeps its own normal (an
+        // average would tilt both by 45°, and renderers light such points differently).
+        for t in tris(Shape::Lathe {
+            profile: vec![[0.5, 0.0], [0.5, 1.0], [0.0, 1.0]],
+            segments,
+        }) {
+            let ng = (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]).normalize();
+            assert!(t.n.iter().all(|n| n.dot(ng) > tol), "{:?} vs {ng}", t.n);
+        }
+        // A quarter circle in 5° steps shades smoothly: one normal per point, the radial one.
+        let arc: Vec<[f32; 2]> = (0..=18)
+            .map(|k| (k as f32 * 5.0).to_radians())
+            .map(|a| [0.2 + a.cos(), a.sin()])
+            .collect();
+        for t in tris(Shape::Lathe {
+            profile: arc,
+            segments,
+        }) {
+            for (p, n) in t.p.iter().zip(t.n) {
+                let local = *p - Vec3::new(1.0, 2.0, 3.0);
+                let r = Vec2::new(local.x, -local.z).length();
+                let radial = Vec2::new(r - 0.2, local.y).normalize();
+                let along = Vec2::new(Vec2::new(n.x, -n.z).length(), n.y);
+                assert!(radial.dot(along) > 0.999, "{along} vs {radial} at {p}");
             }
         }
     }
