@@ -23,6 +23,8 @@ const RAY_EPS: f32 = 1e-4;
 struct Arrival {
     pdf: f32,
     is_delta: bool,
+    /// The vertex the path left: light selection depends on the shading point.
+    from: Vec3,
 }
 
 impl RenderScene {
@@ -42,32 +44,33 @@ impl RenderScene {
         let mut arrival = Arrival {
             pdf: 0.0,
             is_delta: true,
+            from: origin,
         };
-        for depth in 0..settings.max_depth {
+        // One pass more than `max_depth` vertices: the last vertex's BSDF-sampled ray only
+        // picks up the light it hits, the MIS partner of that vertex's light sample (as pbrt
+        // and Mitsuba do). A light sample taking all the direct light alone instead would be
+        // unbiased too, but fires on glossy surfaces: its pdf knows nothing of the lobe.
+        for depth in 0..=settings.max_depth {
             let Some(h) = hit else {
                 radiance += beta * self.environment;
                 break;
             };
-            let p = origin + dir * h.t;
             radiance += beta * self.emitted(&h, dir, arrival);
+            if depth == settings.max_depth {
+                break;
+            }
+            let p = origin + dir * h.t;
             let s = &self.geometry.shading[h.tri as usize];
             let mat = &self.materials[s.material as usize];
             let bsdf = mat.surface(self.geometry.uv(&h));
             let wo = -dir.normalize();
             let frame = Frame::from_normal(self.shading_normal(&h, wo, mat.glass_ior.is_some()));
             let wo_l = frame.to_local(wo);
-            // At the last vertex no BSDF-sampled ray follows to pick up the other MIS share of
-            // the direct light, so the light sample takes all of it (and the ray is not traced).
-            let last = depth + 1 == settings.max_depth;
             if !bsdf.is_delta() && !self.lights.is_empty() {
-                let ld = self.direct_light(p, &h, &frame, wo_l, &bsdf, last, sampler);
-                radiance += beta * ld;
+                radiance += beta * self.direct_light(p, &h, &frame, wo_l, &bsdf, sampler);
             }
             if !bsdf.is_delta() && !self.punctual_lights.is_empty() {
                 radiance += beta * self.punctual_light(p, &h, &frame, wo_l, &bsdf);
-            }
-            if last {
-                break;
             }
             let Some(bs) = bsdf.sample(wo_l, sampler.next_f32(), sampler.next2()) else {
                 break;
@@ -79,6 +82,7 @@ impl RenderScene {
             arrival = Arrival {
                 pdf: bs.pdf,
                 is_delta: bs.is_delta,
+                from: p,
             };
             if depth + 1 >= settings.rr_depth {
                 let survive = beta.max_element().min(0.95);
@@ -116,13 +120,14 @@ impl RenderScene {
         if arrival.is_delta {
             return mat.emission;
         }
-        let light_pdf = self.lights.pdf(&self.geometry, h.tri, dist, cos_light);
+        let light_pdf = self
+            .lights
+            .pdf(&self.geometry, h.tri, arrival.from, dist, cos_light);
         mat.emission * power_heuristic(arrival.pdf, light_pdf)
     }
 
     /// One light sample with a shadow ray through semi-transparent surfaces, MIS-weighted
-    /// against BSDF sampling unless `alone` (no BSDF sample follows).
-    #[allow(clippy::too_many_arguments)]
+    /// against BSDF sampling.
     fn direct_light(
         &self,
         p: Vec3,
@@ -130,12 +135,12 @@ impl RenderScene {
         frame: &Frame,
         wo_l: Vec3,
         bsdf: &super::bsdf::SurfaceParams,
-        alone: bool,
         sampler: &mut Sampler,
     ) -> Vec3 {
         let ls = self.lights.sample(
             &self.geometry,
             &self.materials,
+            p,
             sampler.next_f32(),
             sampler.next2(),
         );
@@ -151,19 +156,15 @@ impl RenderScene {
         if f == Vec3::ZERO {
             return Vec3::ZERO;
         }
-        let origin = self.spawn(p, h.tri, wi);
-        let tmax = (ls.p - origin).length() * (1.0 - 1e-3);
-        let tr = self
-            .geometry
-            .transmittance(&self.materials, origin, wi, tmax);
+        // Aim just off the light, on the side facing `p`: a ray that reached the light's
+        // surface could count the light itself as the occluder.
+        let target = ls.p + ls.n * ray_eps(ls.p);
+        let tr = self.visibility(p, h.tri, target);
         if tr <= 0.0 {
             return Vec3::ZERO;
         }
         let light_pdf = ls.pdf_area * dist * dist / cos_light;
-        let weight = match alone {
-            true => 1.0,
-            false => power_heuristic(light_pdf, bsdf_pdf),
-        };
+        let weight = power_heuristic(light_pdf, bsdf_pdf);
         f * ls.emission * (tr * wi_l.z.abs() * weight / light_pdf)
     }
 
@@ -187,14 +188,13 @@ impl RenderScene {
             if f == Vec3::ZERO {
                 continue;
             }
-            let origin = self.spawn(p, h.tri, inc.wi);
-            let tmax = match inc.dist.is_finite() {
-                true => (p + inc.wi * inc.dist - origin).length() * (1.0 - 1e-3),
-                false => f32::INFINITY,
+            let tr = match inc.dist.is_finite() {
+                true => self.visibility(p, h.tri, p + inc.wi * inc.dist),
+                false => {
+                    let origin = self.spawn(p, h.tri, inc.wi);
+                    (self.geometry).transmittance(&self.materials, origin, inc.wi, f32::INFINITY)
+                }
             };
-            let tr = self
-                .geometry
-                .transmittance(&self.materials, origin, inc.wi, tmax);
             sum += f * inc.irradiance * (tr * wi_l.z.abs());
         }
         sum
@@ -216,7 +216,22 @@ impl RenderScene {
     /// Ray origin just off the surface, on the side `dir` leaves to.
     fn spawn(&self, p: Vec3, tri: u32, dir: Vec3) -> Vec3 {
         let ng = self.geometry.geometric_normal(tri);
-        let eps = RAY_EPS * p.abs().max_element().max(1.0);
-        p + ng * eps.copysign(ng.dot(dir))
+        p + ng * ray_eps(p).copysign(ng.dot(dir))
     }
+
+    /// Transmittance of the segment from just off the surface at `p` (triangle `tri`) to
+    /// `target`. The shadow ray is aimed from the offset origin itself: along the direction
+    /// from `p` it would end beside `target`, by as much as the offset over the cosine, which
+    /// within ~10³ offsets of a light reaches into the light's own surface.
+    fn visibility(&self, p: Vec3, tri: u32, target: Vec3) -> f32 {
+        let origin = self.spawn(p, tri, target - p);
+        let to_target = target - origin;
+        let dist = to_target.length();
+        (self.geometry).transmittance(&self.materials, origin, to_target / dist, dist)
+    }
+}
+
+/// Distance of a ray's origin from the surface it leaves, relative to the scene scale.
+fn ray_eps(p: Vec3) -> f32 {
+    RAY_EPS * p.abs().max_element().max(1.0)
 }

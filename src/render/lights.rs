@@ -1,7 +1,14 @@
-//! Area lights: emissive triangles sampled in proportion to their power, for next-event
-//! estimation, and the matching pdf for MIS when a BSDF-sampled path hits one. Punctual
-//! lights (point, spot, directional) have no area: a path can never hit them, so they are
-//! reached by next-event estimation alone, without MIS.
+//! Area lights: emissive triangles for next-event estimation, and the matching pdf for MIS
+//! when a BSDF-sampled path hits one. Punctual lights (point, spot, directional) have no area:
+//! a path can never hit them, so they are reached by next-event estimation alone, without MIS.
+//!
+//! Emissive triangles are grouped into clusters, one per emissive object. A light sample first
+//! picks a cluster in proportion to its power over the squared distance from the shading point
+//! (clamped to the cluster's bounding radius), then a triangle of it in proportion to power,
+//! then a uniform point. Power alone would almost never pick a lamp bulb next to a ceiling
+//! panel of a hundred times its power, and the blocks lit by the bulb stayed noisy at 1 024 spp
+//! (README, Validation: direct light). Every cluster keeps a positive probability everywhere, so
+//! the estimate stays unbiased; only the variance moves.
 
 use super::geometry::Geometry;
 use super::material::RenderMaterial;
@@ -10,6 +17,8 @@ use glam::{Vec2, Vec3};
 
 /// A sampled point on a light.
 pub struct LightSample {
+    /// The triangle (BVH order) the point lies on.
+    pub tri: u32,
     pub p: Vec3,
     pub n: Vec3,
     pub emission: Vec3,
@@ -17,50 +26,165 @@ pub struct LightSample {
     pub pdf_area: f32,
 }
 
-/// Power-proportional distribution over emissive triangles.
+/// Most clusters a scene gets: choosing one costs a pass over all of them per light sample,
+/// so scenes with more emissive objects merge neighbours in scene order (still unbiased, just
+/// less selective).
+const MAX_CLUSTERS: usize = 64;
+
+/// Marks a triangle that emits nothing in [`Lights::slot`].
+const NOT_EMISSIVE: u32 = u32::MAX;
+
+/// Emissive triangles of one object (or of neighbouring objects, past [`MAX_CLUSTERS`]).
+struct Cluster {
+    /// Range of the cluster's triangles in [`Lights::tris`].
+    start: u32,
+    end: u32,
+    power: f32,
+    centre: Vec3,
+    /// Squared bounding radius, the least squared distance the importance divides by: closer
+    /// than that the inverse-square law says nothing about a light's extent.
+    radius2: f32,
+}
+
+impl Cluster {
+    /// Unnormalised probability of choosing this cluster for a shading point at `p`.
+    fn importance(&self, p: Vec3) -> f32 {
+        self.power / p.distance_squared(self.centre).max(self.radius2)
+    }
+}
+
+/// Object, original triangle index, BVH leaf and power of an emitting triangle.
+type EmittingLeaf = (u32, u32, u32, f32);
+
+/// Emissive triangles grouped into clusters, sampled as the module describes.
 pub struct Lights {
+    clusters: Vec<Cluster>,
+    /// Emissive triangles (BVH order), cluster after cluster.
     tris: Vec<u32>,
+    /// Per emissive triangle: cumulative probability within its cluster.
     cdf: Vec<f32>,
-    /// Selection probability per triangle (BVH order), 0 for non-emitters.
+    /// Per emissive triangle: probability within its cluster, and its cluster.
     pmf: Vec<f32>,
+    cluster: Vec<u32>,
+    /// Per triangle of the scene (BVH order): its index in `tris`, or [`NOT_EMISSIVE`].
+    slot: Vec<u32>,
 }
 
 impl Lights {
+    /// Collects the emitting triangles, one cluster per object (by object order past
+    /// [`MAX_CLUSTERS`]).
     pub fn new(geo: &Geometry, mats: &[RenderMaterial]) -> Self {
-        let mut tris = Vec::new();
-        let mut weights = Vec::new();
-        for (i, s) in geo.shading.iter().enumerate() {
-            let e = mats[s.material as usize].emission;
-            if e.max_element() > 0.0 {
-                tris.push(i as u32);
-                weights.push(area(&geo.vertices(i as u32)) * e.dot(Vec3::splat(1.0 / 3.0)));
-            }
-        }
-        let total: f32 = weights.iter().sum();
-        let mut pmf = vec![0.0; geo.shading.len()];
-        let mut acc = 0.0;
-        let cdf = tris
-            .iter()
-            .zip(&weights)
-            .map(|(&t, w)| {
-                pmf[t as usize] = w / total;
-                acc += w / total;
-                acc
+        let mut leaves: Vec<EmittingLeaf> = (0..geo.shading.len() as u32)
+            .filter_map(|leaf| {
+                let s = &geo.shading[leaf as usize];
+                let e = mats[s.material as usize]
+                    .emission
+                    .dot(Vec3::splat(1.0 / 3.0));
+                let power = area(&geo.vertices(leaf)) * e;
+                (power > 0.0).then_some((s.object, s.id, leaf, power))
             })
             .collect();
-        Self { tris, cdf, pmf }
+        leaves.sort_by_key(|&(object, id, leaf, _)| (object, id, leaf));
+        let objects: Vec<&[EmittingLeaf]> = leaves.chunk_by(|a, b| a.0 == b.0).collect();
+        let mut lights = Self {
+            clusters: Vec::new(),
+            tris: Vec::new(),
+            cdf: Vec::new(),
+            pmf: Vec::new(),
+            cluster: Vec::new(),
+            slot: vec![NOT_EMISSIVE; geo.shading.len()],
+        };
+        for group in objects.chunks(objects.len().div_ceil(MAX_CLUSTERS).max(1)) {
+            lights.push_cluster(geo, group.iter().flat_map(|o| o.iter()));
+        }
+        lights
+    }
+
+    /// Appends one cluster. A triangle that spatial splits left in several BVH leaves counts
+    /// once: each of its leaves maps to the first.
+    fn push_cluster<'a>(&mut self, geo: &Geometry, leaves: impl Iterator<Item = &'a EmittingLeaf>) {
+        let index = self.clusters.len() as u32;
+        let start = self.tris.len() as u32;
+        let (mut lo, mut hi, mut power) = (Vec3::INFINITY, Vec3::NEG_INFINITY, 0.0);
+        let mut last_id = None;
+        for &(_, id, leaf, w) in leaves {
+            if last_id == Some(id) {
+                self.slot[leaf as usize] = self.tris.len() as u32 - 1;
+                continue;
+            }
+            last_id = Some(id);
+            for v in geo.vertices(leaf) {
+                (lo, hi) = (lo.min(v), hi.max(v));
+            }
+            power += w;
+            self.slot[leaf as usize] = self.tris.len() as u32;
+            self.tris.push(leaf);
+            self.pmf.push(w);
+            self.cluster.push(index);
+        }
+        let mut acc = 0.0;
+        for p in &mut self.pmf[start as usize..] {
+            *p /= power;
+            acc += *p;
+            self.cdf.push(acc);
+        }
+        self.clusters.push(Cluster {
+            start,
+            end: self.tris.len() as u32,
+            power,
+            centre: 0.5 * (lo + hi),
+            radius2: (0.25 * (hi - lo).length_squared()).max(f32::MIN_POSITIVE),
+        });
     }
 
     pub fn is_empty(&self) -> bool {
         self.tris.is_empty()
     }
 
-    /// Samples a point on a light with one number for the triangle and two for the point.
-    pub fn sample(&self, geo: &Geometry, mats: &[RenderMaterial], u: f32, uv: Vec2) -> LightSample {
-        let k = self
-            .cdf
-            .partition_point(|&c| c <= u)
-            .min(self.tris.len() - 1);
+    /// The sum of every cluster's importance for a shading point at `p`.
+    fn total_importance(&self, p: Vec3) -> f32 {
+        self.clusters.iter().map(|c| c.importance(p)).sum()
+    }
+
+    /// Probability of choosing cluster `c` for a shading point at `p`.
+    fn cluster_probability(&self, c: &Cluster, p: Vec3) -> f32 {
+        match self.clusters.len() {
+            1 => 1.0,
+            _ => c.importance(p) / self.total_importance(p),
+        }
+    }
+
+    /// Picks a cluster for a shading point at `p` with `u` in [0, 1); returns it and `u`
+    /// rescaled to [0, 1) within its share, for choosing the triangle.
+    fn pick_cluster(&self, p: Vec3, u: f32) -> (&Cluster, f32) {
+        let [only] = &self.clusters[..] else {
+            let mut rest = u * self.total_importance(p);
+            for c in &self.clusters {
+                let w = c.importance(p);
+                if rest < w {
+                    return (c, (rest / w).min(ONE_BELOW));
+                }
+                rest -= w;
+            }
+            // Rounding left `u` past the last share.
+            return (self.clusters.last().unwrap(), ONE_BELOW);
+        };
+        (only, u)
+    }
+
+    /// Samples a point on a light for a shading point at `from`, with one number for the
+    /// cluster and triangle and two for the point.
+    pub fn sample(
+        &self,
+        geo: &Geometry,
+        mats: &[RenderMaterial],
+        from: Vec3,
+        u: f32,
+        uv: Vec2,
+    ) -> LightSample {
+        let (c, u) = self.pick_cluster(from, u);
+        let cdf = &self.cdf[c.start as usize..c.end as usize];
+        let k = c.start as usize + cdf.partition_point(|&x| x <= u).min(cdf.len() - 1);
         let tri = self.tris[k];
         let v = geo.vertices(tri);
         let (su, sv) = if uv.x + uv.y > 1.0 {
@@ -71,23 +195,30 @@ impl Lights {
         let p = v[0] + (v[1] - v[0]) * su + (v[2] - v[0]) * sv;
         let emission = mats[geo.shading[tri as usize].material as usize].emission;
         LightSample {
+            tri,
             p,
             n: geo.geometric_normal(tri),
             emission,
-            pdf_area: self.pmf[tri as usize] / area(&v),
+            pdf_area: self.cluster_probability(c, from) * self.pmf[k] / area(&v),
         }
     }
 
-    /// Solid-angle pdf with which [`Self::sample`] would pick this point of triangle `tri`,
-    /// seen from distance `dist` at cosine `cos_light`.
-    pub fn pdf(&self, geo: &Geometry, tri: u32, dist: f32, cos_light: f32) -> f32 {
-        let pmf = self.pmf[tri as usize];
-        if pmf == 0.0 || cos_light <= 0.0 {
+    /// Solid-angle pdf with which [`Self::sample`], called for a shading point at `from`,
+    /// would pick this point of triangle `tri`, seen from distance `dist` at cosine
+    /// `cos_light`.
+    pub fn pdf(&self, geo: &Geometry, tri: u32, from: Vec3, dist: f32, cos_light: f32) -> f32 {
+        let k = self.slot[tri as usize];
+        if k == NOT_EMISSIVE || cos_light <= 0.0 {
             return 0.0;
         }
+        let c = &self.clusters[self.cluster[k as usize] as usize];
+        let pmf = self.cluster_probability(c, from) * self.pmf[k as usize];
         pmf / area(&geo.vertices(tri)) * dist * dist / cos_light
     }
 }
+
+/// The largest f32 below 1: keeps a rescaled random number inside [0, 1).
+const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
 
 fn area(v: &[Vec3; 3]) -> f32 {
     0.5 * (v[1] - v[0]).cross(v[2] - v[0]).length()
