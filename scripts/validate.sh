@@ -6,8 +6,9 @@
 #
 #   scripts/validate.sh            # OUT=target/validation RES=160,120 SPP=1024 VARIANTS=1
 #
-# SPP: samples per pixel of every colour render (all renderers the same); VARIANTS=0 skips the
-# four roughness/metallic variants of the glossy scene. LF=path/to/lfgen uses that binary
+# SPP: samples per pixel of every colour render (all renderers the same); METAL_SPP: the same for
+# the near-mirror metal room (roughness 0.2, metallic 1), whose noise at SPP alone exceeds 1 %;
+# VARIANTS=0 skips the four roughness/metallic variants of the glossy scene. LF=path/to/lfgen uses that binary
 # instead of building one. lfgen runs inside $OUT, so it uses the built-in defaults (= the
 # shipped generator.toml) whatever ./generator.toml holds.
 #
@@ -19,6 +20,7 @@ cd "$(dirname "$0")/.."
 OUT=$(realpath -m "${OUT:-target/validation}")
 RES=${RES:-160,120}
 SPP=${SPP:-1024}
+METAL_SPP=${METAL_SPP:-8192}
 VARIANTS=${VARIANTS:-1}
 if [ -z "${LF:-}" ]; then
     cargo build --release --quiet
@@ -58,25 +60,28 @@ $PY "$VAL" depth "$SCENE" "$OUT/depth/mitsuba" $(bl "$OUT/depth/blender") --work
 
 # One colour case: the depth scene with uniform materials (validate.py match MATCH_ARGS),
 # rendered by lfgen at render.max_depth=DEPTH and exported to the references with the same
-# limit (Mitsuba max_depth DEPTH+1, Cycles DEPTH-1 bounces); centre view, $SPP spp everywhere.
-#   colour NAME DEPTH "MATCH_ARGS" "COLOUR_ARGS" TITLE
+# limit (Mitsuba max_depth DEPTH+1, Cycles DEPTH-1 bounces); centre view, SPP (default $SPP)
+# spp everywhere. Russian roulette is off (rr_depth past the last vertex) in lfgen and Mitsuba:
+# it trades noise for speed, and the table measures differences that noise blurs.
+#   colour NAME DEPTH "MATCH_ARGS" "COLOUR_ARGS" TITLE [SPP]
 colour() {
-    local name=$1 depth=$2 match=$3 args=$4 title=$5 dir="$OUT/colour/$1"
+    local name=$1 depth=$2 match=$3 args=$4 title=$5 spp=${6:-$SPP} dir="$OUT/colour/$1"
+    local limits=(--set render.max_depth="$depth" --set render.rr_depth=$((depth + 1)))
     rm -rf "$dir"
     mkdir -p "$dir/matched"
     # shellcheck disable=SC2086
     $PY "$VAL" match "$SCENE/scene.json" "$OUT/depth/blender/blender_scene.json" \
         "$dir/matched/scene.json" $match
     (cd "$OUT" && $PY "$VAL" timed "$dir/lfgen_seconds" "$LF" render "$dir/matched/scene.json" \
-        --out "$dir/lfgen" --set render.spp="$SPP" --set render.max_depth="$depth" \
+        --out "$dir/lfgen" --set render.spp="$spp" "${limits[@]}" \
         --set render.write_exr=true --quiet)
-    lf export --to mitsuba "$dir/matched" --out "$dir/mitsuba" --set render.max_depth="$depth"
-    lf export --to blender "$dir/matched" --out "$dir/blender" --set render.max_depth="$depth"
-    lf export --to pov "$dir/matched" --out "$dir/pov" --set render.max_depth="$depth"
+    lf export --to mitsuba "$dir/matched" --out "$dir/mitsuba" "${limits[@]}"
+    lf export --to blender "$dir/matched" --out "$dir/blender" "${limits[@]}"
+    lf export --to pov "$dir/matched" --out "$dir/pov" "${limits[@]}"
     $PY "$VAL" povdirect "$dir/pov" "$dir/blender"
     # shellcheck disable=SC2086
     $PY "$VAL" colour "$dir/lfgen/input_Cam000.exr" "$dir/lfgen_seconds" --mitsuba "$dir/mitsuba" \
-        --spp "$SPP" --work "$dir" --title "$title" $args
+        --spp "$spp" --work "$dir" --title "$title" $args
 }
 
 echo "== colour and speed: the depth scene with uniform opaque materials, centre view, $SPP spp"
@@ -90,11 +95,11 @@ colour principled 5 "--dielectric-only" \
     "--variants scalar_rgb $(bl "$OUT/colour/principled/blender")" \
     "the same scene vs the references' own principled BSDFs (Disney diffuse, not lfgen's model)"
 if [ "$VARIANTS" = 1 ]; then
-    for rm in "0.2 0" "0.8 0" "0.2 1" "0.8 1"; do
+    for rm in "0.2 0 $SPP" "0.8 0 $SPP" "0.2 1 $METAL_SPP" "0.8 1 $SPP"; do
         set -- $rm
         colour "r$1_m$2" 5 "--dielectric-only --roughness $1 --metallic $2" \
             "--variants llvm_ad_rgb --lfgen-bsdf" \
-            "every Standard material roughness $1, metallic $2, vs lfgen_standard in Mitsuba"
+            "every Standard material roughness $1, metallic $2, vs lfgen_standard in Mitsuba" "$3"
     done
 fi
 

@@ -152,7 +152,7 @@ struct ExportArgs {
     /// Views as off-axis cameras: all, center, or a list such as 0,40,80.
     #[arg(long, default_value = "all")]
     views: String,
-    /// The config's render.max_depth sets the renderers' bounce limits.
+    /// The config's render.max_depth and render.rr_depth set the renderers' path limits.
     #[command(flatten)]
     common: ConfigArgs,
 }
@@ -220,8 +220,11 @@ fn run(cli: Cli) -> Result<()> {
             let cfg = load(&a.common)?;
             let target = lfgen::export::Target::parse(&a.to)?;
             let views = lfgen::export::extract::ViewSelection::parse(&a.views)?;
-            let depth = cfg.render.max_depth;
-            lfgen::export::export_scene_dir(&a.scene_dir, target, &a.out, &views, depth)
+            let limits = lfgen::export::PathLimits {
+                max_depth: cfg.render.max_depth,
+                rr_depth: cfg.render.rr_depth,
+            };
+            lfgen::export::export_scene_dir(&a.scene_dir, target, &a.out, &views, limits)
         }
         None => generate(cli.generate),
     }

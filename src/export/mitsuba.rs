@@ -6,9 +6,10 @@
 //! `principal_point_offset_y = −py / H` in film units, `(px, py)` the principal point's offset
 //! from the image centre in pixels (x right, y down) — Mitsuba offsets the frustum, the
 //! opposite sign (checked against lfgen's per-view depth by scripts/validate.py); one-sided BSDFs are wrapped in `twosided` (lfgen shades both sides); opacity below 1
-//! is a `mask`. `$spp`, `$max_depth` and `$jitter` are parameters with defaults, e.g.
+//! is a `mask`. `$spp`, `$max_depth`, `$rr_depth` and `$jitter` are parameters with defaults, e.g.
 //! `mi.load_file("scene.xml", spp=1, jitter=False)` for the pixel-centre position AOV.
 
+use super::PathLimits;
 use super::extract::{DepthVisibility, ExportCamera, ExportScene, mean_color, mean_opacity};
 use super::obj;
 use crate::scene::{Light, Material, SurfaceModel};
@@ -19,10 +20,10 @@ use std::path::Path;
 
 /// Writes `scene.xml`, `depth.xml` (only the surfaces lfgen's HCI depth counts, for the
 /// position AOV) and the meshes into `out`.
-pub fn write(scene: &ExportScene, out: &Path, max_depth: u32) -> Result<()> {
+pub fn write(scene: &ExportScene, out: &Path, limits: PathLimits) -> Result<()> {
     super::write_meshes(scene, out)?;
-    super::write_file(&out.join("scene.xml"), &xml(scene, max_depth, false))?;
-    super::write_file(&out.join("depth.xml"), &xml(scene, max_depth, true))
+    super::write_file(&out.join("scene.xml"), &xml(scene, limits, false))?;
+    super::write_file(&out.join("depth.xml"), &xml(scene, limits, true))
 }
 
 fn v3(v: DVec3) -> String {
@@ -33,14 +34,19 @@ fn rgb(c: Vec3) -> String {
     format!("{}, {}, {}", c.x, c.y, c.z)
 }
 
-/// The scene document; `max_depth` is Mitsuba's (path edges: lfgen's vertex count + 1).
+/// The scene document. Mitsuba's `max_depth` counts path edges (lfgen's vertex count + 1);
+/// its `rr_depth` is the vertex from which Russian roulette may end a path, as lfgen's, with
+/// the same survival probability (the throughput's largest component, at most 0.95).
 /// `depth_only` leaves out surfaces that do not hide what is behind them in the HCI depth.
-fn xml(scene: &ExportScene, max_depth: u32, depth_only: bool) -> String {
+fn xml(scene: &ExportScene, limits: PathLimits, depth_only: bool) -> String {
+    let (max_depth, rr_depth) = (limits.max_depth + 1, limits.rr_depth);
     let mut s = format!(
         "<scene version=\"3.0.0\">\n  <default name=\"spp\" value=\"64\"/>\n  \
          <default name=\"max_depth\" value=\"{max_depth}\"/>\n  \
+         <default name=\"rr_depth\" value=\"{rr_depth}\"/>\n  \
          <default name=\"jitter\" value=\"true\"/>\n  \
-         <integrator type=\"path\"><integer name=\"max_depth\" value=\"$max_depth\"/></integrator>\n"
+         <integrator type=\"path\"><integer name=\"max_depth\" value=\"$max_depth\"/>\
+         <integer name=\"rr_depth\" value=\"$rr_depth\"/></integrator>\n"
     );
     for c in &scene.cameras {
         sensor(c, &mut s);

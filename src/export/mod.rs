@@ -36,14 +36,21 @@ impl Target {
     }
 }
 
-/// Exports `SCENE_DIR/scene.json` for `target` into `out` (created) with the views `views`;
-/// `max_depth` is lfgen's path vertex limit (`render.max_depth`), converted per renderer.
+/// Path limits in lfgen's terms (`render.max_depth` vertices, Russian roulette from vertex
+/// `render.rr_depth`), converted per renderer so that a comparison renders the same paths.
+#[derive(Clone, Copy, Debug)]
+pub struct PathLimits {
+    pub max_depth: u32,
+    pub rr_depth: u32,
+}
+
+/// Exports `SCENE_DIR/scene.json` for `target` into `out` (created) with the views `views`.
 pub fn export_scene_dir(
     scene_dir: &Path,
     target: Target,
     out: &Path,
     views: &ViewSelection,
-    max_depth: u32,
+    limits: PathLimits,
 ) -> Result<()> {
     let json = scene_dir.join("scene.json");
     let desc = crate::pipeline::read_scene_json(&json)?;
@@ -54,8 +61,8 @@ pub fn export_scene_dir(
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     match target {
         Target::Pov => pov::write(&scene, out),
-        Target::Mitsuba => mitsuba::write(&scene, out, max_depth + 1),
-        Target::Blender => blender::write(&scene, out, max_depth),
+        Target::Mitsuba => mitsuba::write(&scene, out, limits),
+        Target::Blender => blender::write(&scene, out, limits.max_depth),
     }
 }
 
