@@ -5,10 +5,10 @@
 //! Emissive triangles are grouped into clusters, one per emissive object. A light sample first
 //! picks a cluster in proportion to its power over the squared distance from the shading point
 //! (clamped to the cluster's bounding radius), then a triangle of it in proportion to power,
-//! then a uniform point. Power alone would almost never pick a lamp bulb next to a ceiling
-//! panel of a hundred times its power, and the blocks lit by the bulb stayed noisy at 1 024 spp
-//! (README, Validation: direct light). Every cluster keeps a positive probability everywhere, so
-//! the estimate stays unbiased; only the variance moves.
+//! then a uniform point. Power alone would almost never pick a lamp bulb for the shade around
+//! it, next to ceiling panels of thirty times its power (README, Validation: direct light).
+//! Every cluster keeps a positive probability everywhere, so the estimate stays unbiased; only
+//! the variance moves.
 
 use super::geometry::Geometry;
 use super::material::RenderMaterial;
@@ -154,22 +154,25 @@ impl Lights {
         }
     }
 
-    /// Picks a cluster for a shading point at `p` with `u` in [0, 1); returns it and `u`
-    /// rescaled to [0, 1) within its share, for choosing the triangle.
-    fn pick_cluster(&self, p: Vec3, u: f32) -> (&Cluster, f32) {
+    /// Picks a cluster for a shading point at `p` with `u` in [0, 1); returns it, its
+    /// probability (as [`Self::cluster_probability`] computes it) and `u` rescaled to [0, 1)
+    /// within its share, for choosing the triangle.
+    fn pick_cluster(&self, p: Vec3, u: f32) -> (&Cluster, f32, f32) {
         let [only] = &self.clusters[..] else {
-            let mut rest = u * self.total_importance(p);
+            let total = self.total_importance(p);
+            let mut rest = u * total;
             for c in &self.clusters {
                 let w = c.importance(p);
                 if rest < w {
-                    return (c, (rest / w).min(ONE_BELOW));
+                    return (c, w / total, (rest / w).min(ONE_BELOW));
                 }
                 rest -= w;
             }
             // Rounding left `u` past the last share.
-            return (self.clusters.last().unwrap(), ONE_BELOW);
+            let last = self.clusters.last().unwrap();
+            return (last, last.importance(p) / total, ONE_BELOW);
         };
-        (only, u)
+        (only, 1.0, u)
     }
 
     /// Samples a point on a light for a shading point at `from`, with one number for the
@@ -182,7 +185,7 @@ impl Lights {
         u: f32,
         uv: Vec2,
     ) -> LightSample {
-        let (c, u) = self.pick_cluster(from, u);
+        let (c, probability, u) = self.pick_cluster(from, u);
         let cdf = &self.cdf[c.start as usize..c.end as usize];
         let k = c.start as usize + cdf.partition_point(|&x| x <= u).min(cdf.len() - 1);
         let tri = self.tris[k];
@@ -199,7 +202,7 @@ impl Lights {
             p,
             n: geo.geometric_normal(tri),
             emission,
-            pdf_area: self.cluster_probability(c, from) * self.pmf[k] / area(&v),
+            pdf_area: probability * self.pmf[k] / area(&v),
         }
     }
 
