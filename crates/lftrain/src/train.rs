@@ -138,16 +138,15 @@ impl Trainer {
         let (first, mut last_val) = (self.state.step, None);
         while self.state.step < self.cfg.steps {
             let done = self.state.step;
-            if done > 0
-                && self.cfg.learning_rate_after(done) != self.cfg.learning_rate_after(done - 1)
-            {
-                bar.println(format!(
-                    "step {}: learning rate {:e}",
-                    done + 1,
-                    self.cfg.learning_rate_after(done)
-                ));
+            let lr = self.cfg.learning_rate_after(done);
+            if done > 0 && lr != self.cfg.learning_rate_after(done - 1) {
+                bar.println(format!("step {}: learning rate {lr:e}", done + 1));
             }
+            // Also on the first step after --resume past the freeze: the checkpoint holds the
+            // trained values, not the frozen state.
             if self.cfg.bn_frozen_after(done) && !self.bn_frozen {
+                self.net = self.net.clone().freeze_batch_norm();
+                self.bn_frozen = true;
                 bar.println(format!("step {}: batch norm frozen", done + 1));
             }
             let t0 = Instant::now();
@@ -198,11 +197,6 @@ impl Trainer {
 
     /// One Adam step on `batch`; returns its loss.
     fn step(&mut self, batch: &crate::sample::Batch) -> Result<f64> {
-        let done = self.state.step;
-        if self.cfg.bn_frozen_after(done) && !self.bn_frozen {
-            self.net = self.net.clone().freeze_batch_norm();
-            self.bn_frozen = true;
-        }
         let stacks = stack_tensors(batch, &self.device);
         let targets = target_tensors(batch, &self.cfg, &self.device);
         let out = self.net.forward(stacks);
@@ -215,7 +209,7 @@ impl Trainer {
         let net = self.net.clone();
         self.net = self
             .optim
-            .step(self.cfg.learning_rate_after(done), net, grads);
+            .step(self.cfg.learning_rate_after(self.state.step), net, grads);
         Ok(value)
     }
 }
