@@ -164,8 +164,7 @@ impl RenderScene {
             return Vec3::ZERO;
         }
         let light_pdf = ls.pdf_area * dist * dist / cos_light;
-        let weight = power_heuristic(light_pdf, bsdf_pdf);
-        f * ls.emission * (tr * wi_l.z.abs() * weight / light_pdf)
+        f * ls.emission * (tr * wi_l.z.abs() * power_heuristic(light_pdf, bsdf_pdf) / light_pdf)
     }
 
     /// Light from every punctual light, each with a shadow ray through semi-transparent
@@ -222,12 +221,14 @@ impl RenderScene {
     /// Transmittance of the segment from just off the surface at `p` (triangle `tri`) to
     /// `target`. The shadow ray is aimed from the offset origin itself: along the direction
     /// from `p` it would end beside `target`, by as much as the offset over the cosine, which
-    /// within ~10³ offsets of a light reaches into the light's own surface.
+    /// within ~10³ offsets of a light reaches into the light's own surface. It stops 1e-4
+    /// short, so a point light placed on a surface is not hidden by it.
     fn visibility(&self, p: Vec3, tri: u32, target: Vec3) -> f32 {
         let origin = self.spawn(p, tri, target - p);
         let to_target = target - origin;
         let dist = to_target.length();
-        (self.geometry).transmittance(&self.materials, origin, to_target / dist, dist)
+        let tmax = dist * (1.0 - 1e-4);
+        (self.geometry).transmittance(&self.materials, origin, to_target / dist, tmax)
     }
 }
 
