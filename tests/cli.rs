@@ -3,7 +3,7 @@
 
 mod bin;
 
-use bin::{ok, stderr};
+use bin::{TINY, files, generate, ok, stderr};
 use lfformat::manifest::Manifest;
 use lfformat::pfm::read_pfm;
 use std::collections::BTreeMap;
@@ -11,53 +11,12 @@ use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-/// A tiny but complete dataset: every feature on, seconds to render.
-const TINY: &[&str] = &[
-    "--set",
-    "camera.resolution=[40,32]",
-    "--set",
-    "camera.grid=[3,3]",
-    "--set",
-    "render.spp=2",
-    "--set",
-    "scene.objects=10",
-    "--set",
-    "dataset.date=2026-01-01",
-    "--quiet",
-];
-
 fn lfgen(args: &[&str], extra: &[&str]) -> Output {
     bin::lfgen(&[args, extra].concat())
 }
 
 fn tmp() -> tempfile::TempDir {
     tempfile::tempdir().expect("temp dir")
-}
-
-/// Every file under `root` (relative path → bytes), excluding run timings.
-fn files(root: &Path) -> BTreeMap<String, Vec<u8>> {
-    let mut out = BTreeMap::new();
-    let mut stack = vec![root.to_path_buf()];
-    while let Some(dir) = stack.pop() {
-        for e in fs::read_dir(&dir).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else if p.file_name().unwrap() != "timings.jsonl" {
-                out.insert(
-                    p.strip_prefix(root).unwrap().display().to_string(),
-                    fs::read(&p).unwrap(),
-                );
-            }
-        }
-    }
-    out
-}
-
-fn generate(out: &Path, scenes: &str, extra: &[&str]) -> Output {
-    let mut args = vec!["--scenes", scenes, "--out", out.to_str().unwrap()];
-    args.extend_from_slice(extra);
-    lfgen(&args, TINY)
 }
 
 #[test]

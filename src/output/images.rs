@@ -1,7 +1,11 @@
 //! Colour images: linear radiance → 8-bit sRGB PNG, and optionally linear float EXR.
 
 use anyhow::{Context, Result};
+use exr::prelude::{Image, SpecificChannels, Vec2, WritableImage};
 use glam::Vec3;
+use image::ImageEncoder;
+use lfformat::files::write_file;
+use std::io::Cursor;
 use std::path::Path;
 
 /// The sRGB transfer function of a linear value in [0, 1].
@@ -31,17 +35,37 @@ pub fn write_png(
 ) -> Result<()> {
     let buf = image::RgbImage::from_raw(width as u32, height as u32, to_srgb8(pixels, exposure))
         .context("image size mismatch")?;
-    buf.save(path)
-        .with_context(|| format!("cannot write {}", path.display()))
+    save_png(&buf, path)
 }
 
-/// Linear radiance (before exposure) as a float RGB EXR.
+/// Encodes `img` as PNG in memory and writes it with [`write_file`]: `image`'s own `save`
+/// drops the error of its final flush, so a full disk would publish a truncated file.
+pub fn save_png(img: &image::RgbImage, path: &Path) -> Result<()> {
+    let mut bytes = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut bytes)
+        .write_image(
+            img.as_raw(),
+            img.width(),
+            img.height(),
+            image::ExtendedColorType::Rgb8,
+        )
+        .with_context(|| format!("cannot encode {}", path.display()))?;
+    Ok(write_file(path, &bytes)?)
+}
+
+/// Linear radiance (before exposure) as a float RGB EXR, encoded in memory for the same
+/// reason as [`save_png`].
 pub fn write_linear_exr(path: &Path, width: usize, height: usize, pixels: &[Vec3]) -> Result<()> {
-    exr::prelude::write_rgb_file(path, width, height, |x, y| {
-        let c = pixels[y * width + x];
+    let channels = SpecificChannels::rgb(|Vec2(x, y)| {
+        let c: Vec3 = pixels[y * width + x];
         (c.x, c.y, c.z)
-    })
-    .with_context(|| format!("cannot write {}", path.display()))
+    });
+    let mut bytes = Cursor::new(Vec::new());
+    Image::from_channels((width, height), channels)
+        .write()
+        .to_buffered(&mut bytes)
+        .with_context(|| format!("cannot encode {}", path.display()))?;
+    Ok(write_file(path, bytes.get_ref())?)
 }
 
 #[cfg(test)]

@@ -6,6 +6,7 @@
 //! GT disparity, mode count, η of the second mode, a horizontal and a vertical epipolar-plane
 //! image) and an overview page (`previews/index.html`) with each scene's statistics.
 
+use super::images::save_png;
 use crate::stats::MULTIMODAL_ETA;
 use anyhow::{Context, Result};
 use image::{Rgb, RgbImage};
@@ -44,10 +45,7 @@ pub fn write_preview(out: &Path, scene_dirs: &[String]) -> Result<()> {
             );
         }
     }
-    let path = out.join("preview.png");
-    sheet
-        .save(&path)
-        .with_context(|| format!("cannot write {}", path.display()))
+    save_png(&sheet, &out.join("preview.png"))
 }
 
 /// Reads view `index` (`input_CamNNN.png`) of a scene folder.
@@ -102,10 +100,7 @@ pub fn write_contact_sheets(dataset: &Path) -> Result<usize> {
         let dir = dataset.join(&e.dir);
         let sheet = contact_sheet(&dir).with_context(|| format!("{}", dir.display()))?;
         let name = format!("{}.png", e.dir.replace('/', "_"));
-        let path = out.join(&name);
-        sheet
-            .save(&path)
-            .with_context(|| format!("cannot write {}", path.display()))?;
+        save_png(&sheet, &out.join(&name))?;
         rows.push_str(&overview_row(&dir, &e.dir, &name)?);
     }
     let html = format!(
@@ -116,7 +111,7 @@ pub fn write_contact_sheets(dataset: &Path) -> Result<usize> {
         dataset.display()
     );
     let index = out.join("index.html");
-    std::fs::write(&index, html).with_context(|| format!("cannot write {}", index.display()))?;
+    lfformat::files::write_file(&index, html.as_bytes())?;
     Ok(manifest.scenes.len())
 }
 

@@ -1,11 +1,17 @@
 //! One scene folder (SPEC §4), written atomically: into `.NAME.partial`, then renamed.
+//!
+//! While a scene is written its folder is locked (`.NAME.lock`, see [`Lock`]), so two runs
+//! never write into one partial folder. An existing folder at the final place is replaced only
+//! if it holds nothing but the files a scene writer writes: `--out` pointing at a dataset, a
+//! glTF's own folder or any other folder of the user's is refused before anything renders.
 
 use super::images::{write_linear_exr, write_png};
 use crate::camera::LightFieldCamera;
 use crate::scene::SceneDesc;
 use crate::stats::SceneStats;
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use glam::Vec3;
+use lfformat::lock::Lock;
 use lfformat::manifest::{FileEntry, sha256_file};
 use lfformat::modes::write_modes_exr;
 use lfformat::mpi::{Mpi, write_mpi_npz};
@@ -20,6 +26,8 @@ pub struct SceneWriter {
     final_dir: PathBuf,
     tmp_dir: PathBuf,
     write_exr: bool,
+    /// Held until the folder is published (or the writer is dropped on an error).
+    _lock: Lock,
 }
 
 /// Ground truth of one view, as the writer needs it.
@@ -32,12 +40,19 @@ pub struct GtImages<'a> {
 }
 
 impl SceneWriter {
-    /// Starts a scene that will end up at `final_dir` (a stale partial folder is removed).
+    /// Starts a scene that will end up at `final_dir`: locks it, checks that whatever is there
+    /// may be replaced, and removes a stale partial folder of a killed run.
     pub fn create(final_dir: &Path, write_exr: bool) -> Result<Self> {
         let name = final_dir
             .file_name()
             .context("scene folder has no name")?
             .to_string_lossy();
+        if let Some(parent) = final_dir.parent().filter(|p| !p.as_os_str().is_empty()) {
+            fs::create_dir_all(parent)
+                .with_context(|| format!("cannot create {}", parent.display()))?;
+        }
+        let lock = Lock::exclusive(&final_dir.with_file_name(format!(".{name}.lock")))?;
+        check_replaceable(final_dir)?;
         let tmp_dir = final_dir.with_file_name(format!(".{name}.partial"));
         if tmp_dir.exists() {
             fs::remove_dir_all(&tmp_dir)
@@ -49,6 +64,7 @@ impl SceneWriter {
             final_dir: final_dir.to_path_buf(),
             tmp_dir,
             write_exr,
+            _lock: lock,
         })
     }
 
@@ -134,20 +150,98 @@ impl SceneWriter {
         params.write(&self.path("parameters.cfg"))?;
         write_json(&self.path("scene.json"), desc)?;
         write_json(&self.path("stats.json"), stats)?;
-        if self.final_dir.exists() {
-            fs::remove_dir_all(&self.final_dir)
-                .with_context(|| format!("cannot replace {}", self.final_dir.display()))?;
-        }
-        fs::rename(&self.tmp_dir, &self.final_dir)
-            .with_context(|| format!("cannot rename {} into place", self.tmp_dir.display()))?;
+        self.publish()?;
         list_files(&self.final_dir, root)
     }
+
+    /// Renames the partial folder into place. A previous scene there (checked replaceable at
+    /// [`Self::create`], and again here) is first renamed aside and removed only after.
+    fn publish(&self) -> Result<()> {
+        let old = match fs::symlink_metadata(&self.final_dir) {
+            Ok(_) => {
+                check_replaceable(&self.final_dir)?;
+                let old = self.tmp_dir.with_extension("old");
+                if old.exists() {
+                    fs::remove_dir_all(&old)
+                        .with_context(|| format!("cannot remove stale {}", old.display()))?;
+                }
+                fs::rename(&self.final_dir, &old)
+                    .with_context(|| format!("cannot replace {}", self.final_dir.display()))?;
+                Some(old)
+            }
+            Err(_) => None,
+        };
+        fs::rename(&self.tmp_dir, &self.final_dir)
+            .with_context(|| format!("cannot rename {} into place", self.tmp_dir.display()))?;
+        if let Some(old) = old {
+            fs::remove_dir_all(&old)
+                .with_context(|| format!("cannot remove the replaced {}", old.display()))?;
+        }
+        Ok(())
+    }
+}
+
+/// Fails unless `dir` is absent, or a folder holding only files a [`SceneWriter`] writes.
+pub fn check_replaceable(dir: &Path) -> Result<()> {
+    let meta = match fs::symlink_metadata(dir) {
+        Ok(m) => m,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => return Err(e).with_context(|| format!("cannot inspect {}", dir.display())),
+    };
+    if !meta.is_dir() {
+        bail!(
+            "{} exists and is not a folder: choose a new or empty folder for the scene",
+            dir.display()
+        );
+    }
+    for entry in fs::read_dir(dir).with_context(|| format!("cannot list {}", dir.display()))? {
+        let entry = entry.with_context(|| format!("cannot list {}", dir.display()))?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let is_file = entry.file_type().is_ok_and(|t| t.is_file());
+        if !is_file || !is_scene_file(&name) {
+            bail!(
+                "{} already holds {name:?}, which is not a file of an lfgen scene: lfgen \
+                 replaces only a previous scene folder; choose a new or empty folder",
+                dir.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Whether `name` is one of the files [`SceneWriter`] writes.
+fn is_scene_file(name: &str) -> bool {
+    const FIXED: [&str; 4] = [
+        "parameters.cfg",
+        "scene.json",
+        "stats.json",
+        "gt_mpi_lowres.npz",
+    ];
+    let per_view = |stem: &str, ext: &str| {
+        name.strip_prefix(stem)
+            .and_then(|rest| rest.strip_suffix(ext))
+            .is_some_and(|mid| {
+                mid.is_empty()
+                    || mid
+                        .strip_prefix("_Cam")
+                        .is_some_and(|n| n.len() == 3 && n.bytes().all(|b| b.is_ascii_digit()))
+            })
+    };
+    let view = name
+        .strip_prefix("input_Cam")
+        .and_then(|r| r.strip_suffix(".png").or_else(|| r.strip_suffix(".exr")))
+        .is_some_and(|n| n.len() == 3 && n.bytes().all(|b| b.is_ascii_digit()));
+    FIXED.contains(&name)
+        || view
+        || per_view("gt_depth_lowres", ".pfm")
+        || per_view("gt_disp_lowres", ".pfm")
+        || per_view("modes", ".exr")
 }
 
 /// Pretty JSON, with the path in any error.
 pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<()> {
-    let text = serde_json::to_string_pretty(value)?;
-    fs::write(path, text + "\n").with_context(|| format!("cannot write {}", path.display()))
+    let text = serde_json::to_string_pretty(value)? + "\n";
+    Ok(lfformat::files::write_file(path, text.as_bytes())?)
 }
 
 /// Checksums of every file in `dir`, sorted by name, paths relative to `root`.

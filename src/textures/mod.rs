@@ -55,9 +55,7 @@ pub fn write_library(out: &Path, count: u32, seed: u64) -> Result<Catalog> {
             let rgb = to_srgb8(&render(&spec, TEXTURE_PX), 1.0);
             let img =
                 image::RgbImage::from_raw(TEXTURE_PX, TEXTURE_PX, rgb).context("texture size")?;
-            let path = out.join(&file);
-            img.save(&path)
-                .with_context(|| format!("cannot write {}", path.display()))?;
+            crate::output::images::save_png(&img, &out.join(&file))?;
             Ok(CatalogEntry {
                 file,
                 spec,

@@ -2,6 +2,9 @@
 //! a part of it).
 #![allow(dead_code)]
 
+use std::collections::BTreeMap;
+use std::fs;
+use std::path::Path;
 use std::process::{Command, Output};
 
 /// Runs `lfgen` with `args`.
@@ -39,4 +42,46 @@ pub fn scene_files(views: u32) -> Vec<String> {
     );
     names.sort();
     names
+}
+
+/// A tiny but complete dataset: every feature on, seconds to render.
+pub const TINY: &[&str] = &[
+    "--set",
+    "camera.resolution=[40,32]",
+    "--set",
+    "camera.grid=[3,3]",
+    "--set",
+    "render.spp=2",
+    "--set",
+    "scene.objects=10",
+    "--set",
+    "dataset.date=2026-01-01",
+    "--quiet",
+];
+
+/// Every file under `root` (relative path → bytes), excluding run timings.
+pub fn files(root: &Path) -> BTreeMap<String, Vec<u8>> {
+    let mut out = BTreeMap::new();
+    let mut stack = vec![root.to_path_buf()];
+    while let Some(dir) = stack.pop() {
+        for e in fs::read_dir(&dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.file_name().unwrap() != "timings.jsonl" {
+                out.insert(
+                    p.strip_prefix(root).unwrap().display().to_string(),
+                    fs::read(&p).unwrap(),
+                );
+            }
+        }
+    }
+    out
+}
+
+pub fn generate(out: &Path, scenes: &str, extra: &[&str]) -> Output {
+    let mut args = vec!["--scenes", scenes, "--out", out.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    args.extend_from_slice(TINY);
+    lfgen(&args)
 }

@@ -7,6 +7,8 @@
 //! that contributes to a pixel, and `manifest.json` ties a dataset's scenes together.
 
 pub mod error;
+pub mod files;
+pub mod lock;
 pub mod manifest;
 pub mod modes;
 pub mod mpi;

@@ -2,10 +2,9 @@
 //! with its checksum, so that resumed or sharded runs can tell finished scenes from broken ones.
 
 use std::collections::BTreeMap;
-use std::ffi::OsString;
 use std::fs::File;
-use std::io::{Read, Write};
-use std::path::{Path, PathBuf};
+use std::io::Read;
+use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -62,26 +61,14 @@ impl Manifest {
         serde_json::from_slice(&text).map_err(|e| Error::format(path, e.to_string()))
     }
 
-    /// Writes pretty JSON atomically: to `<path>.tmp`, synced, then renamed over `path`, so
-    /// an interrupted run never leaves a truncated manifest behind.
+    /// Writes pretty JSON atomically ([`crate::files::write_atomic`]: a temporary name of this
+    /// process, synced, then renamed over `path`), so an interrupted run never leaves a
+    /// truncated manifest behind and two runs never write into one temporary file.
     pub fn write(&self, path: &Path) -> Result<()> {
         let mut text = serde_json::to_string_pretty(self).expect("a Manifest always serialises");
         text.push('\n');
-        let tmp = tmp_path(path);
-        let written = File::create(&tmp).and_then(|mut file| {
-            file.write_all(text.as_bytes())?;
-            file.sync_all()
-        });
-        written.map_err(|e| Error::io(&tmp, e))?;
-        std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e))
+        crate::files::write_atomic(path, text.as_bytes())
     }
-}
-
-/// `path` with `.tmp` appended to its full file name (`manifest.json.tmp`).
-fn tmp_path(path: &Path) -> PathBuf {
-    let mut name = OsString::from(path.as_os_str());
-    name.push(".tmp");
-    name.into()
 }
 
 /// Lowercase hex SHA-256 and size of the file at `path`, read in chunks so that large
@@ -108,14 +95,17 @@ pub fn sha256_file(path: &Path) -> Result<(String, u64)> {
     Ok((hex, bytes))
 }
 
-/// Whether every file of `e` exists under `root` with the recorded size and hash.
+/// Whether every file of `e` exists under `root` with the recorded size and hash. An entry
+/// without files never verifies: a scene always has some, so an empty list is damage.
 ///
 /// Any error (missing file, unreadable file) means "does not verify": the caller's remedy
 /// is the same, re-generating the scene.
 pub fn scene_entry_verifies(root: &Path, e: &SceneEntry) -> bool {
-    e.files.iter().all(|f| {
-        let path = root.join(&f.path);
-        let size_matches = std::fs::metadata(&path).is_ok_and(|m| m.len() == f.bytes);
-        size_matches && sha256_file(&path).is_ok_and(|(hex, _)| hex.eq_ignore_ascii_case(&f.sha256))
-    })
+    !e.files.is_empty()
+        && e.files.iter().all(|f| {
+            let path = root.join(&f.path);
+            let size_matches = std::fs::metadata(&path).is_ok_and(|m| m.len() == f.bytes);
+            size_matches
+                && sha256_file(&path).is_ok_and(|(hex, _)| hex.eq_ignore_ascii_case(&f.sha256))
+        })
 }

@@ -208,10 +208,12 @@ pub fn write_modes_exr(path: &Path, map: &ModeMap) -> Result<()> {
         Encoding::SMALL_LOSSLESS,
         AnyChannels::sort(channels.into()),
     );
+    let mut bytes = std::io::Cursor::new(Vec::new());
     Image::from_layer(layer)
         .write()
-        .to_file(path)
-        .map_err(|e| exr_error(path, e))
+        .to_buffered(&mut bytes)
+        .map_err(|e| exr_error(path, e))?;
+    crate::files::write_file(path, bytes.get_ref())
 }
 
 /// Reads a `modes.exr`; slots with `eta == 0` and `eta_exact == 0` are dropped.

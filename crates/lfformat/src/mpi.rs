@@ -5,7 +5,7 @@
 //! bottom-up (that loader flips axis 0, as for PFM), NaN where a pixel has fewer than `L`
 //! layers (the loader reads NaN as 0).
 
-use std::io::{BufReader, BufWriter, Write};
+use std::io::{BufReader, BufWriter, Cursor};
 use std::path::Path;
 
 use npyz::npz::{NpzArchive, NpzWriter, file_name_from_array_name};
@@ -99,7 +99,7 @@ impl Mpi {
 pub fn write_mpi_npz(path: &Path, mpi: &Mpi) -> Result<()> {
     let io = |e| Error::io(path, e);
     let shape = [mpi.height, mpi.width, mpi.layers, CHANNELS].map(|n| n as u64);
-    let mut npz = NpzWriter::create(path).map_err(io)?;
+    let mut npz = NpzWriter::new(Cursor::new(Vec::new()));
     let zip = npz.zip_writer();
     // A fixed timestamp (1980-01-01, zip's epoch): the same data must give the same bytes.
     let options = FileOptions::default().last_modified_time(DateTime::default());
@@ -116,7 +116,8 @@ pub fn write_mpi_npz(path: &Path, mpi: &Mpi) -> Result<()> {
         .extend(flip_rows(&mpi.data, mpi.row_len()).flatten().copied())
         .map_err(io)?;
     array.finish().map_err(io)?;
-    zip.finish().map_err(|e| io(e.into()))?.flush().map_err(io)
+    let bytes = zip.finish().map_err(|e| io(e.into()))?.into_inner();
+    crate::files::write_file(path, &bytes)
 }
 
 /// Reads the `mpi` array of an npz written by [`write_mpi_npz`] (or by numpy), top-down.

@@ -123,7 +123,7 @@ impl HciParameters {
 
     /// Writes [`HciParameters::to_ini`] to `path`.
     pub fn write(&self, path: &Path) -> Result<()> {
-        std::fs::write(path, self.to_ini()).map_err(|e| Error::io(path, e))
+        crate::files::write_file(path, self.to_ini().as_bytes())
     }
 
     /// Focal length in pixels; HCI's sensor size is the larger side, so is the pixel count.

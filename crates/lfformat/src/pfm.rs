@@ -93,7 +93,7 @@ pub fn decode_pfm(bytes: &[u8], path: &Path) -> Result<FloatImage> {
 
 /// Writes `img` to `path` as an HCI-style PFM.
 pub fn write_pfm(path: &Path, img: &FloatImage) -> Result<()> {
-    std::fs::write(path, encode_pfm(img)).map_err(|e| Error::io(path, e))
+    crate::files::write_file(path, &encode_pfm(img))
 }
 
 /// Reads a single-channel PFM from `path`, top-down.

@@ -1,0 +1,260 @@
+//! Data-loss faults, made real: an output folder full of someone else's files, a write that
+//! fails with ENOSPC (injected with `strace`), two processes into one dataset, and a deleted
+//! manifest. Each test fails on a generator that deletes, publishes a truncated file, mixes
+//! two runs or leaves unlisted scenes beside a new dataset.
+
+mod bin;
+
+use bin::{TINY, files, generate, lfgen, ok, stderr};
+use lfformat::manifest::{Manifest, scene_entry_verifies};
+use std::fs;
+use std::path::Path;
+use std::process::{Command, Output, Stdio};
+
+fn tmp() -> tempfile::TempDir {
+    tempfile::tempdir().expect("temp dir")
+}
+
+fn render(input: &Path, out: &Path) -> Output {
+    let args = [
+        &[
+            "render",
+            input.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ][..],
+        TINY,
+    ]
+    .concat();
+    lfgen(&args)
+}
+
+fn failed_with(out: &Output, needle: &str) {
+    assert!(
+        !out.status.success() && stderr(out).contains(needle),
+        "expected a failure mentioning {needle:?}, got {:?}: {}",
+        out.status,
+        stderr(out)
+    );
+}
+
+#[test]
+fn render_never_replaces_a_folder_lfgen_did_not_write() {
+    let d = tmp();
+    let ds = d.path().join("ds");
+    ok(generate(&ds, "1", &[]));
+    let json = ds.join("train/scene_0000/scene.json");
+    let before = files(&ds);
+    // A dataset root.
+    failed_with(&render(&json, &ds), "not a file of an lfgen scene");
+    assert!(files(&ds) == before, "the dataset was changed");
+    // A glTF's own folder.
+    let gltf_dir = d.path().join("gltf");
+    fs::create_dir(&gltf_dir).unwrap();
+    for f in ["plane.gltf", "plane.bin"] {
+        fs::copy(Path::new("tests/fixtures/gltf").join(f), gltf_dir.join(f)).unwrap();
+    }
+    let gltf_before = files(&gltf_dir);
+    failed_with(
+        &render(&gltf_dir.join("plane.gltf"), &gltf_dir),
+        "plane.bin",
+    );
+    assert!(
+        files(&gltf_dir) == gltf_before,
+        "the glTF folder was changed"
+    );
+    // A regular file: refused before anything renders.
+    let file = d.path().join("notes.txt");
+    fs::write(&file, "keep me").unwrap();
+    failed_with(&render(&json, &file), "not a folder");
+    assert_eq!(fs::read_to_string(&file).unwrap(), "keep me");
+    // A previous scene folder is replaced, leaving nothing beside it.
+    let again = d.path().join("again");
+    ok(render(&json, &again));
+    fs::write(again.join("input_Cam000.png"), "stale").unwrap();
+    ok(render(&json, &again));
+    assert!(files(&again) == files(&ds.join("train/scene_0000")));
+    let leftovers: Vec<_> = fs::read_dir(d.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('.'))
+        .collect();
+    assert!(leftovers.is_empty(), "left behind: {leftovers:?}");
+}
+
+/// Runs `lfgen` under `strace`, every `write` to `victim` failing with ENOSPC; `None` (with the
+/// reason printed) where strace is missing or may not trace.
+fn with_full_disk_at(victim: &Path, args: &[&str]) -> Option<Output> {
+    let probe = Command::new("strace")
+        .args(["-qq", "-o", "/dev/null", "true"])
+        .status();
+    if !probe.is_ok_and(|s| s.success()) {
+        eprintln!("skipped: strace is missing or cannot trace here (.ci/run installs it)");
+        return None;
+    }
+    let output = Command::new("strace")
+        .args(["-f", "-qq", "-o", "/dev/null", "-e", "trace=write"])
+        .args(["-e", "inject=write:error=ENOSPC", "-P"])
+        .arg(victim)
+        .arg(env!("CARGO_BIN_EXE_lfgen"))
+        .args(args)
+        .output()
+        .expect("strace runs");
+    Some(output)
+}
+
+#[test]
+fn a_failed_write_names_its_file_and_publishes_nothing() {
+    for victim in ["input_Cam004.png", "modes.exr", "gt_mpi_lowres.npz"] {
+        let d = tmp();
+        let out = d.path().join("ds");
+        let partial = out.join("train/.scene_0000.partial").join(victim);
+        let mut args = vec!["--scenes", "1", "--out", out.to_str().unwrap()];
+        args.extend_from_slice(TINY);
+        let Some(r) = with_full_disk_at(&partial, &args) else {
+            return;
+        };
+        failed_with(&r, victim);
+        failed_with(&r, "No space left on device");
+        assert!(
+            !out.join("train/scene_0000").exists(),
+            "{victim}: a scene with a failed write was published"
+        );
+        let listed = Manifest::read(&out.join("manifest.json")).map_or(0, |m| m.scenes.len());
+        assert_eq!(listed, 0, "{victim}: the manifest lists a broken scene");
+        // The next run completes the dataset as if nothing had happened.
+        ok(generate(&out, "1", &["--resume"]));
+        let reference = tmp();
+        ok(generate(reference.path(), "1", &[]));
+        assert!(files(&out) == files(reference.path()), "{victim}");
+    }
+}
+
+#[test]
+fn a_failed_preview_write_fails_the_run() {
+    let d = tmp();
+    let out = d.path().join("ds");
+    let mut args = vec!["--scenes", "1", "--out", out.to_str().unwrap()];
+    args.extend_from_slice(TINY);
+    let Some(r) = with_full_disk_at(&out.join("preview.png"), &args) else {
+        return;
+    };
+    failed_with(&r, "preview.png");
+}
+
+fn spawn(out: &Path, extra: &[&str]) -> std::process::Child {
+    Command::new(env!("CARGO_BIN_EXE_lfgen"))
+        .args(["--scenes", "3", "--out", out.to_str().unwrap()])
+        .args(extra)
+        .args(TINY)
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("lfgen starts")
+}
+
+/// Starts both runs at once and returns their outputs.
+fn race(out: &Path, a: &[&str], b: &[&str]) -> (Output, Output) {
+    let (pa, pb) = (spawn(out, a), spawn(out, b));
+    (
+        pa.wait_with_output().unwrap(),
+        pb.wait_with_output().unwrap(),
+    )
+}
+
+#[test]
+fn two_runs_into_one_folder_never_mix() {
+    let (d, seed1) = (tmp(), tmp());
+    ok(generate(seed1.path(), "3", &["--seed", "1"]));
+    let out = d.path().join("ds");
+    let (a, b) = race(&out, &["--seed", "1"], &["--seed", "2"]);
+    let (winner, loser) = match (a.status.success(), b.status.success()) {
+        (true, false) => ("1", &b),
+        (false, true) => ("2", &a),
+        _ => panic!(
+            "exactly one run must win: {:?} {:?}\n{}\n{}",
+            a.status,
+            b.status,
+            stderr(&a),
+            stderr(&b)
+        ),
+    };
+    failed_with(loser, "in use by another lfgen run");
+    let reference = tmp();
+    ok(generate(reference.path(), "3", &["--seed", winner]));
+    assert!(
+        files(&out) == files(reference.path()),
+        "the winner's dataset is not intact"
+    );
+    if winner == "1" {
+        assert!(files(&out) == files(seed1.path()));
+    }
+    // The same shard twice is refused; two different shards run side by side and merge into
+    // the plain dataset.
+    let sharded = d.path().join("sharded");
+    let (a, b) = race(&sharded, &["--shard", "0/2"], &["--shard", "0/2"]);
+    assert!(
+        a.status.success() != b.status.success(),
+        "{}\n{}",
+        stderr(&a),
+        stderr(&b)
+    );
+    failed_with(if a.status.success() { &b } else { &a }, "shard");
+    let (a, b) = race(
+        &d.path().join("both"),
+        &["--shard", "0/2"],
+        &["--shard", "1/2"],
+    );
+    ok(a);
+    ok(b);
+    ok(lfgen(&["merge", d.path().join("both").to_str().unwrap()]));
+    let mut merged = files(&d.path().join("both"));
+    merged.retain(|k, _| !k.starts_with("manifest.shard-"));
+    let plain = tmp();
+    ok(generate(plain.path(), "3", &[]));
+    assert!(
+        merged == files(plain.path()),
+        "merged shards differ from one run"
+    );
+    // A shard of another split layout, and an unsharded run, are refused beside shards.
+    let r = generate(&d.path().join("both"), "3", &["--shard", "0/3"]);
+    failed_with(&r, "2-way split");
+}
+
+#[test]
+fn a_deleted_manifest_never_leaves_unlisted_scenes_beside_a_new_dataset() {
+    let (d, reference) = (tmp(), tmp());
+    ok(generate(reference.path(), "3", &[]));
+    let out = d.path().join("ds");
+    ok(generate(&out, "3", &["--seed", "9"]));
+    fs::remove_file(out.join("manifest.json")).unwrap();
+    let before = files(&out);
+    let r = generate(&out, "3", &[]);
+    failed_with(&r, "no manifest lists");
+    failed_with(&r, "--resume");
+    assert!(files(&out) == before, "a refused run changed the folder");
+    // Fewer scenes than the folder holds: the extra ones would be left beside the manifest.
+    let r = generate(&out, "2", &["--resume"]);
+    failed_with(&r, "train/scene_0002");
+    // Resuming the same size re-renders every unlisted scene: the result is the plain dataset.
+    ok(generate(&out, "3", &["--resume"]));
+    assert!(files(&out) == files(reference.path()));
+    let m = Manifest::read(&out.join("manifest.json")).unwrap();
+    assert_eq!(m.scenes.len(), 3);
+    assert!(m.scenes.iter().all(|e| scene_entry_verifies(&out, e)));
+}
+
+#[test]
+fn resume_with_nothing_to_do_keeps_the_readme_and_empty_entries_never_verify() {
+    let d = tmp();
+    ok(generate(d.path(), "2", &[]));
+    let readme = fs::read_to_string(d.path().join("README.md")).unwrap();
+    assert!(readme.contains("2 train"), "{readme}");
+    ok(generate(d.path(), "2", &["--resume"]));
+    assert_eq!(
+        fs::read_to_string(d.path().join("README.md")).unwrap(),
+        readme
+    );
+    let mut m = Manifest::read(&d.path().join("manifest.json")).unwrap();
+    m.scenes[0].files.clear();
+    assert!(!scene_entry_verifies(d.path(), &m.scenes[0]));
+}
