@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 
 /// Camera grid and its per-scene baseline and focus.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct LightFieldCamera {
     pub resolution: [u32; 2],
     pub grid: [u32; 2],

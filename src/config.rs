@@ -305,6 +305,15 @@ pub const PRESETS: &[(&str, &[&str])] = &[
     ("wide", &["camera.disparity_range=[-40.0,40.0]"]),
 ];
 
+/// Largest camera grid side (HCI uses 9; 33 × 33 views is already 1 089 renders).
+pub const MAX_GRID: u32 = 33;
+/// Largest samples per pixel.
+pub const MAX_SPP: u32 = 1 << 16;
+/// Largest slice count (every pixel of a thread keeps a few values per slice).
+pub const MAX_SLICES: u32 = 4096;
+/// Longest path.
+pub const MAX_DEPTH: u32 = 1024;
+
 impl Config {
     /// Loads `path` (or the built-in defaults when `None`), then applies presets and overrides.
     pub fn load(path: Option<&Path>, presets: &[String], sets: &[String]) -> Result<Self> {
@@ -338,11 +347,15 @@ impl Config {
         Ok(cfg)
     }
 
-    /// Semantic checks that serde cannot express.
+    /// Semantic checks that serde cannot express. The upper bounds keep a typo (or a hostile
+    /// `--set`) from allocating gigabytes: each is far beyond any useful setting.
     pub fn validate(&self) -> Result<()> {
         let c = &self.camera;
-        if c.grid.iter().any(|&n| n == 0 || n % 2 == 0) {
-            bail!("camera.grid must be odd counts (HCI), got {:?}", c.grid);
+        if c.grid.iter().any(|&n| n == 0 || n % 2 == 0 || n > MAX_GRID) {
+            bail!(
+                "camera.grid must be odd counts (HCI) of at most {MAX_GRID}, got {:?}",
+                c.grid
+            );
         }
         if c.resolution.iter().any(|&n| n == 0 || n > 16384) {
             bail!("camera.resolution out of range: {:?}", c.resolution);
@@ -367,6 +380,15 @@ impl Config {
         let r = &self.render;
         if r.spp == 0 || r.slices == 0 || r.max_depth == 0 {
             bail!("render.spp, render.slices and render.max_depth must be at least 1");
+        }
+        if r.spp > MAX_SPP || r.slices > MAX_SLICES || r.max_depth > MAX_DEPTH {
+            bail!(
+                "render.spp (≤ {MAX_SPP}), render.slices (≤ {MAX_SLICES}) or render.max_depth \
+                 (≤ {MAX_DEPTH}) is too large: {}, {}, {}",
+                r.spp,
+                r.slices,
+                r.max_depth
+            );
         }
         if !(0.0..1.0).contains(&r.mode_epsilon) || !r.exposure.is_finite() || r.exposure <= 0.0 {
             bail!("render.mode_epsilon must be in [0, 1) and render.exposure positive");

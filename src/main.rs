@@ -233,6 +233,9 @@ fn run(cli: Cli) -> Result<()> {
 /// Loads the config and sets up the thread pool.
 fn load(a: &ConfigArgs) -> Result<Config> {
     if let Some(n) = a.threads {
+        if n == 0 || n > MAX_THREADS {
+            bail!("--threads {n}: expected 1 to {MAX_THREADS}");
+        }
         rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build_global()
@@ -246,6 +249,13 @@ fn load(a: &ConfigArgs) -> Result<Config> {
     Config::load(path.as_deref(), &a.preset, &a.sets)
 }
 
+/// More worker threads than this only cost memory (each keeps per-pixel buffers).
+const MAX_THREADS: usize = 1024;
+
+/// Scene folders are numbered with four or more digits; ten million scenes is far beyond any
+/// dataset and keeps the progress arithmetic in range.
+const MAX_SCENES: u64 = 10_000_000;
+
 fn generate(a: GenerateArgs) -> Result<()> {
     let mut cfg = load(&a.common)?;
     if let Some(seed) = a.seed {
@@ -255,8 +265,12 @@ fn generate(a: GenerateArgs) -> Result<()> {
         Some(s) => parse_shard(s)?,
         None => (0, 1),
     };
+    let scenes = a.scenes.unwrap_or(cfg.dataset.scenes);
+    if scenes > MAX_SCENES {
+        bail!("--scenes {scenes}: at most {MAX_SCENES}");
+    }
     let opts = GenerateOptions {
-        scenes: a.scenes.unwrap_or(cfg.dataset.scenes),
+        scenes,
         out: a.out.unwrap_or_else(|| PathBuf::from(&cfg.dataset.out)),
         shard,
         resume: a.resume,

@@ -75,6 +75,8 @@ pub fn generate_scene(
     library: Option<&AssetLibrary>,
 ) -> Result<(SceneDesc, RenderScene)> {
     let mut desc = builtin::generate(cfg, index, library);
+    desc.validate()
+        .context("the generator made an invalid scene")?;
     let assets = Assets::load(&desc)?;
     let scene = RenderScene::build_with(&desc, &assets)?;
     desc.slices = scene.frame(
@@ -197,6 +199,8 @@ pub fn render_gltf(cfg: &Config, gltf: &Path, out: &Path, quiet: bool) -> Result
         eprintln!("warning: {}: {w}", gltf.display());
     }
     let mut desc = imported.desc;
+    desc.validate()
+        .with_context(|| format!("{}: unsupported scene", gltf.display()))?;
     let scene = RenderScene::build_with(&desc, &imported.assets)
         .with_context(|| gltf.display().to_string())?;
     desc.slices = scene
@@ -236,10 +240,12 @@ pub fn rerender(cfg: &Config, scene_json: &Path, out: &Path, quiet: bool) -> Res
 
 /// Reads a saved `scene.json`, naming the file in errors.
 pub fn read_scene_json(path: &Path) -> Result<SceneDesc> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    serde_json::from_str(&text)
-        .with_context(|| format!("{}: not a valid lfgen scene", path.display()))
+    let bytes = crate::scene::files::read_limited(path)?;
+    let desc: SceneDesc = serde_json::from_slice(&bytes)
+        .with_context(|| format!("{}: not a valid lfgen scene", path.display()))?;
+    desc.validate()
+        .with_context(|| format!("{}: not a valid lfgen scene", path.display()))?;
+    Ok(desc)
 }
 
 /// `dataset.date`, or today when it is empty.

@@ -2,23 +2,43 @@
 //! textures) safely: bounded sizes, and relative references that cannot leave their folder.
 
 use anyhow::{Context, Result, bail, ensure};
+use std::io::Read;
 use std::path::{Path, PathBuf};
 
 /// Largest file (model, buffer or image) that is read.
 pub const MAX_FILE_BYTES: u64 = 2 << 30;
 
-/// Reads a whole file after checking its size.
+/// Reads a whole regular file of at most [`MAX_FILE_BYTES`]. Devices, FIFOs and sockets are
+/// refused before they are opened (their size reads 0, `/dev/zero` never ends and opening a
+/// FIFO blocks), and the read itself stops past the limit in case the file grows meanwhile.
 pub fn read_limited(path: &Path) -> Result<Vec<u8>> {
-    let len = std::fs::metadata(path)
-        .with_context(|| format!("cannot read {}", path.display()))?
-        .len();
+    let meta =
+        std::fs::metadata(path).with_context(|| format!("cannot read {}", path.display()))?;
     ensure!(
-        len <= MAX_FILE_BYTES,
-        "{} is {len} bytes, more than the {} GiB lfgen reads",
-        path.display(),
-        MAX_FILE_BYTES >> 30
+        meta.is_file(),
+        "{} is not a regular file (a device, FIFO or folder): not read",
+        path.display()
     );
-    std::fs::read(path).with_context(|| format!("cannot open {}", path.display()))
+    let too_big = || {
+        anyhow::anyhow!(
+            "{} is more than the {} GiB lfgen reads",
+            path.display(),
+            MAX_FILE_BYTES >> 30
+        )
+    };
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(too_big());
+    }
+    let file =
+        std::fs::File::open(path).with_context(|| format!("cannot open {}", path.display()))?;
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    file.take(MAX_FILE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .with_context(|| format!("cannot read {}", path.display()))?;
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(too_big());
+    }
+    Ok(bytes)
 }
 
 /// Resolves the relative path `rel` (`/` or `\\` separated) from the folder `base` inside the

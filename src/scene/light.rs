@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 
 /// A light without area, in world space.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "type", rename_all = "snake_case")]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Light {
     /// Luminous intensity `intensity` (cd, linear RGB) in every direction from `position`.
     Point {

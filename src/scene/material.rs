@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 
 /// A surface: scattering model, base colour, opacity (cut-outs, semi-transparency), emission.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Material {
     pub name: String,
     pub model: SurfaceModel,
@@ -22,7 +23,7 @@ pub struct Material {
 
 /// The scattering model of a material.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "type", rename_all = "snake_case")]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum SurfaceModel {
     /// Lambert diffuse under a GGX glossy layer.
     Standard,
@@ -39,7 +40,7 @@ pub enum SurfaceModel {
 /// [`Texture::Image`] only names its image; the renderer binds the decoded pixels
 /// (`render::material`), and [`Texture::eval`] on its own returns the factor.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "type", rename_all = "snake_case")]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Texture {
     Constant {
         color: [f32; 3],
@@ -85,7 +86,7 @@ pub enum Texture {
 /// As with [`Texture::Image`], [`Opacity::Image`] is bound to its pixels by the renderer;
 /// [`Opacity::eval`] on its own treats the image's alpha as 1.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "type", rename_all = "snake_case")]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Opacity {
     Constant {
         value: f32,
@@ -121,6 +122,21 @@ impl Material {
 impl Texture {
     pub fn constant(c: [f32; 3]) -> Self {
         Texture::Constant { color: c }
+    }
+
+    /// Whether colours are finite and non-negative and feature sizes positive (a loaded or
+    /// hand-edited scene; [`Texture::eval`] divides by the sizes).
+    pub fn is_valid(&self) -> bool {
+        let rgb = |c: &[f32; 3]| c.iter().all(|v| v.is_finite() && *v >= 0.0);
+        let size = |s: f32| s.is_finite() && s > 0.0;
+        match self {
+            Texture::Constant { color } => rgb(color),
+            Texture::Checker { a, b, size: s } => rgb(a) && rgb(b) && size(*s),
+            Texture::Stripes { a, b, width } => rgb(a) && rgb(b) && size(*width),
+            Texture::Noise { a, b, scale, .. } => rgb(a) && rgb(b) && size(*scale),
+            Texture::Library { tint, .. } => rgb(tint),
+            Texture::Image { factor, .. } => rgb(factor),
+        }
     }
 
     pub fn eval(&self, uv: Vec2) -> Vec3 {

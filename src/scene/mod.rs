@@ -20,6 +20,7 @@ pub mod openings;
 pub mod placement;
 pub mod shapes;
 pub mod texture_image;
+mod validate;
 
 use crate::camera::LightFieldCamera;
 use crate::config::SliceSpacing;
@@ -30,6 +31,7 @@ use serde::{Deserialize, Serialize};
 
 /// A complete, re-renderable scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SceneDesc {
     /// `lfgen <version>` that produced it.
     pub generator: String,
@@ -60,6 +62,7 @@ pub struct SceneDesc {
 /// A file the scene's meshes and images are read from, with checksums so that a re-render
 /// notices when it changed.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SourceFile {
     /// Absolute path of the glTF, GLB or OBJ file.
     pub path: String,
@@ -77,6 +80,7 @@ pub struct SourceFile {
 
 /// An external file referenced by a glTF, by its URI relative to the glTF's folder.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Resource {
     pub uri: String,
     pub sha256: String,
@@ -84,6 +88,7 @@ pub struct Resource {
 
 /// The depth range `[z_near, z_far]` cut into `count` slices.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SliceRange {
     pub z_near: f64,
     pub z_far: f64,
@@ -145,6 +150,7 @@ mod tests {
 
 /// One placed shape.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Object {
     pub name: String,
     pub shape: Shape,
@@ -155,7 +161,7 @@ pub struct Object {
 
 /// Parametric shapes, in local coordinates (metres).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "type", rename_all = "snake_case")]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Shape {
     /// Axis-aligned box centred at the origin, outward normals.
     Cuboid { size: Vec3 },
@@ -205,6 +211,7 @@ pub enum Shape {
 
 /// Scale, then rotate, then translate.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Transform {
     pub translation: Vec3,
     pub rotation: Quat,

@@ -17,6 +17,7 @@ const MAX_DECODE_BYTES: u64 = 1 << 30;
 
 /// Where a material's texture comes from and how it is sampled.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct ImageMap {
     /// Index into [`crate::scene::SceneDesc::sources`].
     pub source: u32,

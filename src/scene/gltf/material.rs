@@ -71,7 +71,9 @@ fn material(
         name: m.name().unwrap_or("unnamed").to_string(),
         model: match m.transmission() {
             Some(t) if t.transmission_factor() > 0.0 => SurfaceModel::Glass {
-                ior: m.ior().unwrap_or(1.5),
+                // KHR_materials_ior's range is [1, ∞) (0 is a legacy "unset"); lfgen's
+                // glass takes [1, 4], which holds every real material, else the default.
+                ior: m.ior().filter(|i| (1.0..=4.0).contains(i)).unwrap_or(1.5),
             },
             _ => SurfaceModel::Standard,
         },
