@@ -33,10 +33,9 @@ impl Sampler {
     pub fn new(seed: u64, scene: u64, view: u32, x: u32, y: u32, spp: u32) -> Self {
         let key = mix64(mix64(mix64(seed) ^ scene) ^ view as u64);
         let pixel = (y as u64) << 32 | x as u64;
-        let nx = (spp as f64).sqrt().round().max(1.0) as u32;
         Self {
             rng: Pcg32::new(mix64(key ^ pixel), key | 1),
-            strata: [nx, spp.div_ceil(nx)],
+            strata: strata(spp),
         }
     }
 
@@ -74,6 +73,19 @@ impl Sampler {
     }
 }
 
+/// The `nx × ny = spp` grid of pixel strata closest to square: `nx` is the largest divisor of
+/// `spp` not above its square root. Exactly `spp` cells, so every cell gets one sample; a
+/// rounded square root instead left cells empty (spp 8 → 3 × 3 with one never sampled, so
+/// every pixel integrated 8/9 of its area).
+fn strata(spp: u32) -> [u32; 2] {
+    let spp = spp.max(1);
+    let nx = (1..=spp.isqrt())
+        .rev()
+        .find(|d| spp.is_multiple_of(*d))
+        .unwrap_or(1);
+    [nx, spp / nx]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -95,13 +107,28 @@ mod tests {
 
     #[test]
     fn stratified_offsets_cover_every_stratum_once() {
-        let mut s = Sampler::new(0, 0, 0, 0, 0, 16);
-        let mut seen = [0u32; 16];
-        for i in 0..16 {
-            let p = s.pixel_offset(i);
-            assert!(p.x >= 0.0 && p.x < 1.0 && p.y >= 0.0 && p.y < 1.0);
-            seen[(p.y * 4.0) as usize * 4 + (p.x * 4.0) as usize] += 1;
+        for (spp, grid) in [
+            (16, [4, 4]),
+            (8, [2, 4]),
+            (32, [4, 8]),
+            (7, [1, 7]),
+            (1, [1, 1]),
+        ] {
+            assert_eq!(strata(spp), grid, "spp {spp}");
+            let mut s = Sampler::new(0, 0, 0, 0, 0, spp);
+            let [nx, ny] = grid;
+            let mut seen = vec![0u32; spp as usize];
+            for i in 0..spp {
+                let p = s.pixel_offset(i);
+                assert!(p.x >= 0.0 && p.x < 1.0 && p.y >= 0.0 && p.y < 1.0);
+                let cell = (p.y * ny as f32) as usize * nx as usize + (p.x * nx as f32) as usize;
+                seen[cell] += 1;
+            }
+            assert_eq!(
+                seen,
+                vec![1; spp as usize],
+                "spp {spp}: a stratum is empty or doubled"
+            );
         }
-        assert_eq!(seen, [1; 16]);
     }
 }
