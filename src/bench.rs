@@ -1,9 +1,14 @@
 //! `lfgen bench`: throughput of the ray queries and the cost of the 128-slice ground truth,
 //! as ratios measured in one run (absolute figures on a shared machine are noise).
 
-use crate::config::Config;
+use crate::config::{Config, ShadingMode};
+use crate::output::images::to_srgb8;
 use crate::pipeline::{RenderJob, generate_scene};
+use crate::render::framing::auto_exposure;
+use crate::render::integrator::Shading;
+use crate::render::view::RenderSettings;
 use anyhow::Result;
+use glam::Vec3;
 use rayon::prelude::*;
 use std::sync::atomic::AtomicU64;
 use std::time::Instant;
@@ -107,4 +112,128 @@ fn time(f: impl FnOnce()) -> f64 {
     let t = Instant::now();
     f();
     t.elapsed().as_secs_f64()
+}
+
+/// Image side of the quality benchmark's views (the size of the measurements in issue #14).
+const QUALITY_RES: u32 = 128;
+/// Samples per pixel of the converged independent reference.
+const REFERENCE_SPP: u32 = 1024;
+
+/// `lfgen bench --quality`: for built-in scenes `scenes` at 128², the centre view of the
+/// configured settings, shared and independent side by side, against a converged independent
+/// render: PSNR, the photo-consistency residual of the adjacent view, and the time.
+pub fn quality(cfg: &Config, scenes: &[u64]) -> Result<()> {
+    let mut cfg = cfg.clone();
+    cfg.camera.resolution = [QUALITY_RES, QUALITY_RES];
+    println!(
+        "scene | shading | PSNR linear dB | PSNR 8-bit dB | photo residual (8-bit levels) | s per scene"
+    );
+    for &index in scenes {
+        let (desc, scene) = generate_scene(&cfg, index, None)?;
+        let cam = &desc.camera;
+        let center = cam.center_view();
+        let counter = AtomicU64::new(0);
+        let mut job = RenderJob::from_config(&cfg, "");
+        let reference = {
+            let settings = RenderSettings {
+                spp: REFERENCE_SPP,
+                ..job.settings(&desc)
+            };
+            scene.render_view(cam, &desc.slices, &settings, center, true, &counter)
+        };
+        let exposure = desc.exposure * auto_exposure(&reference.image.pixels);
+        let gt = reference.gt.as_ref().expect("reference has GT");
+        let disparity: Vec<f32> = (gt.hci_depth.iter())
+            .map(|&z| cam.disparity(z as f64) as f32)
+            .collect();
+        for shading in [ShadingMode::Shared, ShadingMode::Independent] {
+            job.shading = shading;
+            let settings = job.settings(&desc);
+            let started = Instant::now();
+            let cache = (shading == ShadingMode::Shared)
+                .then(|| scene.fill_cache(cam, &settings, job.cache_spp, job.cache_cell, &counter));
+            let fill = started.elapsed().as_secs_f64();
+            let mode = cache.as_ref().map_or(Shading::Independent, Shading::Read);
+            let render = |view| {
+                let t = Instant::now();
+                let out = scene.render_view_with(
+                    cam,
+                    &desc.slices,
+                    &settings,
+                    view,
+                    false,
+                    mode,
+                    &counter,
+                );
+                (out.image.pixels, t.elapsed().as_secs_f64())
+            };
+            let (c, t_view) = render(center);
+            let (adjacent, _) = render(center + 1);
+            let scene_s = fill + t_view * cam.num_views() as f64;
+            let [w, h] = cam.resolution.map(|n| n as usize);
+            println!(
+                "{index} | {shading:?} | {:.1} | {:.1} | {:.2} | {scene_s:.1}",
+                psnr_linear(&c, &reference.image.pixels, exposure),
+                psnr_8bit(&c, &reference.image.pixels, exposure),
+                photo_residual(&c, &adjacent, &disparity, &gt.modes, [w, h], exposure),
+            );
+        }
+    }
+    Ok(())
+}
+
+/// PSNR of exposure-scaled linear radiance, peak 1 (display white).
+fn psnr_linear(a: &[Vec3], reference: &[Vec3], exposure: f32) -> f64 {
+    let mse = (a.iter().zip(reference))
+        .map(|(&x, &r)| ((x - r) * exposure).length_squared() as f64 / 3.0)
+        .sum::<f64>()
+        / a.len() as f64;
+    -10.0 * mse.log10()
+}
+
+/// PSNR of the 8-bit sRGB images the PNGs hold.
+fn psnr_8bit(a: &[Vec3], reference: &[Vec3], exposure: f32) -> f64 {
+    let (a, r) = (to_srgb8(a, exposure), to_srgb8(reference, exposure));
+    let mse = (a.iter().zip(&r))
+        .map(|(&x, &y)| (x as f64 - y as f64).powi(2))
+        .sum::<f64>()
+        / a.len() as f64;
+    10.0 * (255.0f64 * 255.0 / mse).log10()
+}
+
+/// Mean 8-bit difference between the centre view and the adjacent view (one column to the
+/// right) sampled where the centre's GT disparity puts the same point (`x − d`, bilinear), over
+/// single-mode pixels whose 3×3 neighbourhood lies within 0.1 px of their disparity (away from
+/// depth edges, where the two views see the same surface).
+fn photo_residual(
+    center: &[Vec3],
+    adjacent: &[Vec3],
+    disparity: &[f32],
+    modes: &lfformat::ModeMap,
+    [w, h]: [usize; 2],
+    exposure: f32,
+) -> f64 {
+    let (c8, a8) = (to_srgb8(center, exposure), to_srgb8(adjacent, exposure));
+    let px = |img: &[u8], x: usize, y: usize, ch: usize| img[(y * w + x) * 3 + ch] as f64;
+    let (mut sum, mut n) = (0.0, 0usize);
+    for y in 1..h - 1 {
+        for x in 1..w - 1 {
+            let d = disparity[y * w + x];
+            let flat = (0..9).all(|k| {
+                let dn = disparity[(y + k / 3 - 1) * w + x + k % 3 - 1];
+                (dn - d).abs() < 0.1
+            });
+            let xs = x as f32 - d;
+            if !flat || modes.pixel(x, y).len() != 1 || xs < 0.0 || xs >= (w - 1) as f32 {
+                continue;
+            }
+            let (x0, f) = (xs.floor() as usize, (xs - xs.floor()) as f64);
+            for ch in 0..3 {
+                let s = px(&a8, x0, y, ch) * (1.0 - f) + px(&a8, x0 + 1, y, ch) * f;
+                sum += (s - px(&c8, x, y, ch)).abs();
+            }
+            n += 3;
+        }
+    }
+    sum / n.max(1) as f64
 }

@@ -124,6 +124,17 @@ pub enum SliceAssignment {
     Sample,
 }
 
+/// How the light leaving a surface is estimated across the views of a light field.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ShadingMode {
+    /// The view-independent (diffuse) light is estimated once from the samples of every view
+    /// and shared by all of them; the glossy lobe and delta surfaces stay per view.
+    Shared,
+    /// Every view is path-traced on its own: the unbiased reference.
+    Independent,
+}
+
 /// Path tracer and ground-truth settings.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -149,6 +160,12 @@ pub struct RenderConfig {
     pub auto_exposure: bool,
     /// Multiplier applied on top of (auto) exposure.
     pub exposure: f64,
+    /// `shared` (default) or `independent` shading (see [`ShadingMode`]).
+    pub shading: ShadingMode,
+    /// Shared shading: fill samples per pixel of every view.
+    pub cache_spp: u32,
+    /// Shared shading: cache cell size in pixels of the centre view at the cell's depth.
+    pub cache_cell: f64,
 }
 
 impl Default for RenderConfig {
@@ -166,6 +183,9 @@ impl Default for RenderConfig {
             write_exr: false,
             auto_exposure: true,
             exposure: 1.0,
+            shading: ShadingMode::Shared,
+            cache_spp: 4,
+            cache_cell: 1.0,
         }
     }
 }
@@ -380,6 +400,18 @@ impl Config {
         let r = &self.render;
         if r.spp == 0 || r.slices == 0 || r.max_depth == 0 {
             bail!("render.spp, render.slices and render.max_depth must be at least 1");
+        }
+        if r.cache_spp == 0 || r.cache_spp > MAX_SPP {
+            bail!(
+                "render.cache_spp must be 1 to {MAX_SPP}, got {}",
+                r.cache_spp
+            );
+        }
+        if !(r.cache_cell.is_finite() && (0.05..=64.0).contains(&r.cache_cell)) {
+            bail!(
+                "render.cache_cell must be 0.05 to 64 pixels, got {}",
+                r.cache_cell
+            );
         }
         if r.spp > MAX_SPP || r.slices > MAX_SLICES || r.max_depth > MAX_DEPTH {
             bail!(

@@ -94,7 +94,7 @@ pub fn generate(cfg: &Config, opts: &GenerateOptions) -> Result<()> {
     let [w, h] = cfg.camera.resolution;
     let per_scene = w as u64
         * h as u64
-        * cfg.render.spp as u64
+        * job.samples_per_pixel() as u64
         * (cfg.camera.grid[0] * cfg.camera.grid[1]) as u64;
     let bar = progress_bar(todo.len() as u64 * per_scene, opts.quiet);
     let samples = AtomicU64::new(0);

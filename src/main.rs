@@ -159,6 +159,13 @@ struct ExportArgs {
 
 #[derive(Args, Debug)]
 struct BenchArgs {
+    /// Image quality instead of speed: PSNR against a converged render, the photo-consistency
+    /// residual and the time, shared and independent shading side by side.
+    #[arg(long)]
+    quality: bool,
+    /// Built-in scenes of the quality benchmark.
+    #[arg(long, value_delimiter = ',', default_value = "0,1,2")]
+    scenes: Vec<u64>,
     #[command(flatten)]
     common: ConfigArgs,
 }
@@ -214,7 +221,10 @@ fn run(cli: Cli) -> Result<()> {
         }
         Some(Command::Bench(a)) => {
             let cfg = load(&a.common)?;
-            lfgen::bench::run(&cfg)
+            match a.quality {
+                true => lfgen::bench::quality(&cfg, &a.scenes),
+                false => lfgen::bench::run(&cfg),
+            }
         }
         Some(Command::Export(a)) => {
             let cfg = load(&a.common)?;

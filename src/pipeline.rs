@@ -1,11 +1,11 @@
 //! One scene from description to published folder: build, frame, render every view, write —
 //! for generated scenes, imported glTF scenes and saved `scene.json` files alike.
 
-use crate::config::{BaselineMode, Config, GtViews, SliceAssignment};
+use crate::config::{BaselineMode, Config, GtViews, ShadingMode, SliceAssignment};
 use crate::output::scene_dir::{GtImages, SceneWriter};
 use crate::render::RenderScene;
 use crate::render::framing::auto_exposure;
-use crate::render::integrator::PathSettings;
+use crate::render::integrator::{PathSettings, Shading};
 use crate::render::view::{RenderSettings, ViewOutput};
 use crate::scene::assets::Assets;
 use crate::scene::library::AssetLibrary;
@@ -32,6 +32,9 @@ pub struct RenderJob {
     pub auto_exposure: bool,
     /// Date written into parameters.cfg.
     pub date: String,
+    pub shading: ShadingMode,
+    pub cache_spp: u32,
+    pub cache_cell: f32,
 }
 
 impl RenderJob {
@@ -50,6 +53,17 @@ impl RenderJob {
             slice_by_surface: r.slice_assignment == SliceAssignment::Surface,
             auto_exposure: r.auto_exposure,
             date: date.to_string(),
+            shading: r.shading,
+            cache_spp: r.cache_spp,
+            cache_cell: r.cache_cell as f32,
+        }
+    }
+
+    /// Camera samples per pixel of one view, the fill pass of shared shading included.
+    pub fn samples_per_pixel(&self) -> u32 {
+        match self.shading {
+            ShadingMode::Shared => self.spp + self.cache_spp,
+            ShadingMode::Independent => self.spp,
         }
     }
 
@@ -106,14 +120,25 @@ pub fn render_scene(
     let mut order: Vec<u32> = vec![center];
     order.extend((0..desc.camera.num_views()).filter(|&v| v != center));
     let mut stats = None;
+    let cache = (job.shading == ShadingMode::Shared).then(|| {
+        scene.fill_cache(
+            &desc.camera,
+            &settings,
+            job.cache_spp,
+            job.cache_cell,
+            samples_done,
+        )
+    });
+    let shading = cache.as_ref().map_or(Shading::Independent, Shading::Read);
     for view in order {
         let with_gt = view == center || per_view;
-        let out = scene.render_view(
+        let out = scene.render_view_with(
             &desc.camera,
             &desc.slices,
             &settings,
             view,
             with_gt,
+            shading,
             samples_done,
         );
         if view == center && job.auto_exposure {

@@ -107,6 +107,76 @@ impl SurfaceParams {
     pub fn is_delta(&self) -> bool {
         matches!(self.kind, SurfaceKind::Glass { .. })
     }
+
+    /// [`Self::eval`] restricted to `lobes` (see [`Lobes`]); delta materials give zero.
+    pub fn eval_lobes(&self, wo: Vec3, wi: Vec3, lobes: Lobes) -> (Vec3, f32) {
+        match (lobes, self.kind) {
+            (Lobes::All, _) => self.eval(wo, wi),
+            (_, SurfaceKind::Glass { .. }) => (Vec3::ZERO, 0.0),
+            (Lobes::Specular, _) => StandardLobes::new(self).specular_only(wo, wi),
+            (Lobes::CoupledIrradiance, _) => StandardLobes::new(self).coupling_in(wi),
+        }
+    }
+
+    /// [`Self::sample`] restricted to `lobes`: the glossy lobe by its visible normals, or the
+    /// coupled-irradiance integrand by the cosine.
+    pub fn sample_lobes(&self, wo: Vec3, u_lobe: f32, u: Vec2, lobes: Lobes) -> Option<BsdfSample> {
+        if lobes == Lobes::All || self.is_delta() || wo.z <= 0.0 {
+            return match lobes {
+                Lobes::All => self.sample(wo, u_lobe, u),
+                _ => None,
+            };
+        }
+        let lobe = StandardLobes::new(self);
+        let (wi, (f, pdf)) = match lobes {
+            Lobes::Specular => {
+                let wi = reflect(wo, sample_ggx_vndf(wo, lobe.alpha, u));
+                (wi, lobe.specular_only(wo, wi))
+            }
+            _ => {
+                let wi = cosine_sample_hemisphere(u);
+                (wi, lobe.coupling_in(wi))
+            }
+        };
+        (pdf > 0.0).then_some(BsdfSample {
+            wi,
+            f,
+            pdf,
+            is_delta: false,
+        })
+    }
+
+    /// The outgoing factor of the diffuse term, `ρ/π' · (1 − E(μo))`: the diffuse light
+    /// leaving towards `wo` is this times the coupled irradiance (`render::cache`).
+    pub fn diffuse_out(&self, wo: Vec3) -> Vec3 {
+        if self.is_delta() || wo.z <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let lobe = StandardLobes::new(self);
+        lobe.diffuse * (1.0 - lobe.albedo_split(wo.z).dot(lobe.dielectric))
+    }
+
+    /// The share of the glossy lobe in the light leaving towards `wo` (the probability with
+    /// which [`Self::sample`] picks it); 0 for delta materials.
+    pub fn specular_probability(&self, wo: Vec3) -> f32 {
+        if self.is_delta() || wo.z <= 0.0 {
+            return 0.0;
+        }
+        let lobe = StandardLobes::new(self);
+        lobe.specular_probability(lobe.albedo_split(wo.z))
+    }
+}
+
+/// The part of a vertex's BSDF an estimator integrates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Lobes {
+    /// The whole BSDF (the independent estimator).
+    All,
+    /// The GGX glossy lobe alone: what shared shading keeps per view.
+    Specular,
+    /// `(1 − E(μi))`, no albedo and no `1/π`: the integrand of the coupled irradiance that
+    /// shared shading estimates once for all views, sampled by the cosine.
+    CoupledIrradiance,
 }
 
 /// Orthonormal, right-handed basis around a unit normal, for world <-> local conversion.
@@ -403,6 +473,23 @@ impl StandardLobes {
         // Visible-normal pdf of h times the reflection Jacobian 1/(4 wo·h); wo·h cancels.
         let pdf = d / ((1.0 + lambda_o) * 4.0 * wo.z);
         (f, pdf)
+    }
+
+    /// The glossy lobe alone, with the pdf of sampling it alone.
+    fn specular_only(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return (Vec3::ZERO, 0.0);
+        }
+        self.specular(wo, wi)
+    }
+
+    /// The incident factor of the diffuse coupling, `1 − E(μi)`, with the cosine pdf.
+    fn coupling_in(&self, wi: Vec3) -> (Vec3, f32) {
+        if wi.z <= 0.0 {
+            return (Vec3::ZERO, 0.0);
+        }
+        let c = 1.0 - self.albedo_split(wi.z).dot(self.dielectric);
+        (Vec3::splat(c), wi.z * FRAC_1_PI)
     }
 
     fn eval(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {

@@ -3,7 +3,8 @@
 //! them, deterministically (no random numbers, so scenes without them draw the same streams).
 
 use super::RenderScene;
-use super::bsdf::{Frame, power_heuristic};
+use super::bsdf::{Frame, Lobes, power_heuristic};
+use super::cache::{CacheGrid, RadianceCache};
 use super::geometry::Hit;
 use super::sampler::Sampler;
 use glam::Vec3;
@@ -27,6 +28,25 @@ struct Arrival {
     from: Vec3,
 }
 
+/// How a camera path treats its first non-delta vertex (see [`super::cache`]).
+#[derive(Clone, Copy)]
+pub enum Shading<'a> {
+    /// Every lobe traced by every path: the reference estimator.
+    Independent,
+    /// Estimate the coupled irradiance there and end: one sample for the shared cache.
+    Fill(&'a CacheGrid),
+    /// Diffuse light from the cache, the glossy lobe traced by this path.
+    Read(&'a RadianceCache),
+}
+
+/// What a traced path found.
+pub struct Traced {
+    pub radiance: Vec3,
+    /// With [`Shading::Fill`]: the cell of the first non-delta vertex and the coupled
+    /// irradiance estimated there (none if the path never reached one).
+    pub fill: Option<(u64, Vec3)>,
+}
+
 impl RenderScene {
     /// Radiance arriving along `dir` at `origin`, given the first surface already chosen
     /// (`first`, from the caller's traversal; `None` means the ray escaped).
@@ -38,6 +58,20 @@ impl RenderScene {
         first: Option<Hit>,
         sampler: &mut Sampler,
     ) -> Vec3 {
+        let shading = Shading::Independent;
+        (self.trace(settings, origin, dir, first, sampler, shading)).radiance
+    }
+
+    /// [`Self::radiance`] with the first non-delta vertex shaded as `shading` says.
+    pub fn trace(
+        &self,
+        settings: &PathSettings,
+        origin: Vec3,
+        dir: Vec3,
+        first: Option<Hit>,
+        sampler: &mut Sampler,
+        shading: Shading,
+    ) -> Traced {
         let (mut origin, mut dir, mut hit) = (origin, dir, first);
         let mut radiance = Vec3::ZERO;
         let mut beta = Vec3::ONE;
@@ -46,6 +80,7 @@ impl RenderScene {
             is_delta: true,
             from: origin,
         };
+        let (mut pending, mut fill) = (!matches!(shading, Shading::Independent), None);
         // One pass more than `max_depth` vertices: the last vertex's BSDF-sampled ray only
         // picks up the light it hits, the MIS partner of that vertex's light sample (as pbrt
         // and Mitsuba do). A light sample taking all the direct light alone instead would be
@@ -66,13 +101,37 @@ impl RenderScene {
             let wo = -dir.normalize();
             let frame = Frame::from_normal(self.shading_normal(&h, wo, mat.glass_ior.is_some()));
             let wo_l = frame.to_local(wo);
+            let mut lobes = Lobes::All;
+            if pending && !bsdf.is_delta() {
+                pending = false;
+                match shading {
+                    Shading::Independent => {}
+                    Shading::Fill(grid) => {
+                        // From here the path estimates I(p): light before it is not part of it.
+                        fill = Some(grid.key(p, frame.n, s.material));
+                        (radiance, beta, lobes) = (Vec3::ZERO, Vec3::ONE, Lobes::CoupledIrradiance);
+                    }
+                    Shading::Read(cache) => {
+                        if let Some(i) = cache.lookup(p, frame.n, s.material) {
+                            radiance += beta * bsdf.diffuse_out(wo_l) * i;
+                            // The glossy lobe per view, traced as often as it matters.
+                            let q = bsdf.specular_probability(wo_l);
+                            if q <= 0.0 || sampler.next_f32() >= q {
+                                break;
+                            }
+                            (beta, lobes) = (beta / q, Lobes::Specular);
+                        }
+                    }
+                }
+            }
             if !bsdf.is_delta() && !self.lights.is_empty() {
-                radiance += beta * self.direct_light(p, &h, &frame, wo_l, &bsdf, sampler);
+                radiance += beta * self.direct_light(p, &h, &frame, wo_l, &bsdf, lobes, sampler);
             }
             if !bsdf.is_delta() && !self.punctual_lights.is_empty() {
-                radiance += beta * self.punctual_light(p, &h, &frame, wo_l, &bsdf);
+                radiance += beta * self.punctual_light(p, &h, &frame, wo_l, &bsdf, lobes);
             }
-            let Some(bs) = bsdf.sample(wo_l, sampler.next_f32(), sampler.next2()) else {
+            let Some(bs) = bsdf.sample_lobes(wo_l, sampler.next_f32(), sampler.next2(), lobes)
+            else {
                 break;
             };
             if bs.pdf <= 0.0 {
@@ -101,7 +160,10 @@ impl RenderScene {
                 sampler.next_key(),
             );
         }
-        radiance
+        Traced {
+            radiance,
+            fill: fill.map(|key| (key, radiance)),
+        }
     }
 
     /// Emission picked up at a hit, MIS-weighted against light sampling unless the path
@@ -135,6 +197,7 @@ impl RenderScene {
         frame: &Frame,
         wo_l: Vec3,
         bsdf: &super::bsdf::SurfaceParams,
+        lobes: Lobes,
         sampler: &mut Sampler,
     ) -> Vec3 {
         let ls = self.lights.sample(
@@ -152,7 +215,7 @@ impl RenderScene {
             return Vec3::ZERO;
         }
         let wi_l = frame.to_local(wi);
-        let (f, bsdf_pdf) = bsdf.eval(wo_l, wi_l);
+        let (f, bsdf_pdf) = bsdf.eval_lobes(wo_l, wi_l, lobes);
         if f == Vec3::ZERO {
             return Vec3::ZERO;
         }
@@ -176,6 +239,7 @@ impl RenderScene {
         frame: &Frame,
         wo_l: Vec3,
         bsdf: &super::bsdf::SurfaceParams,
+        lobes: Lobes,
     ) -> Vec3 {
         let mut sum = Vec3::ZERO;
         for light in &self.punctual_lights {
@@ -183,7 +247,7 @@ impl RenderScene {
                 continue;
             };
             let wi_l = frame.to_local(inc.wi);
-            let (f, _) = bsdf.eval(wo_l, wi_l);
+            let (f, _) = bsdf.eval_lobes(wo_l, wi_l, lobes);
             if f == Vec3::ZERO {
                 continue;
             }

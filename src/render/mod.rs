@@ -4,6 +4,7 @@
 //! files.
 
 pub mod bsdf;
+pub mod cache;
 pub mod framing;
 pub mod geometry;
 pub mod integrator;

@@ -2,8 +2,9 @@
 //! for the views that need it.
 
 use super::RenderScene;
+use super::cache::{CacheGrid, CacheSums, RadianceCache};
 use super::geometry::Hit;
-use super::integrator::PathSettings;
+use super::integrator::{PathSettings, Shading};
 use super::sampler::Sampler;
 use super::slices::{SliceAccumulator, SliceHit};
 use crate::camera::{CameraRay, LightFieldCamera, ViewRays};
@@ -78,8 +79,12 @@ struct Band {
     hci_depth: Vec<f32>,
 }
 
+/// Salt of the fill pass's sample streams, so they are not the render's own.
+const FILL_STREAM: u64 = 0xF111_CACE;
+
 impl RenderScene {
-    /// Renders `view`; `samples_done` counts camera samples for progress reporting.
+    /// Renders `view` with the independent estimator; `samples_done` counts camera samples
+    /// for progress reporting.
     pub fn render_view(
         &self,
         cam: &LightFieldCamera,
@@ -87,6 +92,81 @@ impl RenderScene {
         settings: &RenderSettings,
         view: u32,
         with_gt: bool,
+        samples_done: &AtomicU64,
+    ) -> ViewOutput {
+        let shading = Shading::Independent;
+        self.render_view_with(cam, slices, settings, view, with_gt, shading, samples_done)
+    }
+
+    /// Fills the shared-shading cache from `spp` samples per pixel of every view of `cam`
+    /// (views and bands merged in order: the same sums for any thread count).
+    pub fn fill_cache(
+        &self,
+        cam: &LightFieldCamera,
+        settings: &RenderSettings,
+        spp: u32,
+        cell_px: f32,
+        samples_done: &AtomicU64,
+    ) -> RadianceCache {
+        let grid = CacheGrid::new(cam, cell_px);
+        let (w, h) = (cam.width(), cam.height());
+        let mut all = CacheSums::default();
+        for view in 0..cam.num_views() {
+            let rays = cam.view_rays(view);
+            let bands: Vec<CacheSums> = (0..h.div_ceil(BAND_ROWS))
+                .into_par_iter()
+                .map(|b| {
+                    let mut sums = CacheSums::default();
+                    for y in b * BAND_ROWS..((b + 1) * BAND_ROWS).min(h) {
+                        for x in 0..w {
+                            self.fill_pixel(&rays, settings, &grid, (view, x, y), spp, &mut sums);
+                        }
+                        samples_done.fetch_add(w as u64 * spp as u64, Ordering::Relaxed);
+                    }
+                    sums
+                })
+                .collect();
+            bands.into_iter().for_each(|b| all.merge(b));
+        }
+        all.finish(grid)
+    }
+
+    /// The fill samples of one pixel.
+    fn fill_pixel(
+        &self,
+        rays: &ViewRays,
+        s: &RenderSettings,
+        grid: &CacheGrid,
+        (view, x, y): (u32, u32, u32),
+        spp: u32,
+        sums: &mut CacheSums,
+    ) {
+        let scene = s.scene_index ^ FILL_STREAM;
+        let mut sampler = Sampler::new(s.seed, scene, view, x, y, spp);
+        for i in 0..spp {
+            let off = sampler.pixel_offset(i);
+            let ray = rays.ray(x as f32 + off.x, y as f32 + off.y);
+            let key = sampler.next_key();
+            let first =
+                (self.geometry).closest(&self.materials, ray.origin, ray.dir, f32::INFINITY, key);
+            let fill = Shading::Fill(grid);
+            let traced = self.trace(&s.path, ray.origin, ray.dir, first, &mut sampler, fill);
+            if let Some((cell, value)) = traced.fill {
+                sums.add(cell, value);
+            }
+        }
+    }
+
+    /// Renders `view`, its first non-delta vertices shaded as `shading` says.
+    #[allow(clippy::too_many_arguments)]
+    pub fn render_view_with(
+        &self,
+        cam: &LightFieldCamera,
+        slices: &SliceRange,
+        settings: &RenderSettings,
+        view: u32,
+        with_gt: bool,
+        shading: Shading,
         samples_done: &AtomicU64,
     ) -> ViewOutput {
         let (w, h) = (cam.width(), cam.height());
@@ -115,6 +195,7 @@ impl RenderScene {
                                 x,
                                 y,
                                 centre: rays.ray(x as f32 + 0.5, y as f32 + 0.5),
+                                shading,
                             };
                             ctx.render(with_gt, scratch, &mut band);
                         }
@@ -170,6 +251,7 @@ struct PixelCtx<'a> {
     y: u32,
     /// The ray through the pixel centre (HCI depth, slice snapping), computed once per pixel.
     centre: CameraRay,
+    shading: Shading<'a>,
 }
 
 impl PixelCtx<'_> {
@@ -201,8 +283,15 @@ impl PixelCtx<'_> {
                     f32::INFINITY,
                     key,
                 );
-                self.scene
-                    .radiance(&s.path, ray.origin, ray.dir, first, &mut sampler)
+                let traced = (self.scene).trace(
+                    &s.path,
+                    ray.origin,
+                    ray.dir,
+                    first,
+                    &mut sampler,
+                    self.shading,
+                );
+                traced.radiance
             };
         }
         band.pixels.push(sum / s.spp as f32);
@@ -238,7 +327,8 @@ impl PixelCtx<'_> {
         geo.all_hits(origin, dir, f32::INFINITY, &mut scratch.hits);
         let first = scratch.hits.iter().position(|h| geo.accepts(mats, h, key));
         let path = &self.settings.path;
-        let radiance = scene.radiance(path, origin, dir, first.map(|i| scratch.hits[i]), sampler);
+        let first_hit = first.map(|i| scratch.hits[i]);
+        let radiance = (scene.trace(path, origin, dir, first_hit, sampler, self.shading)).radiance;
         scratch.slice_hits.clear();
         for (i, h) in scratch.hits.iter().enumerate() {
             let shaded = match self.settings.shade_all_hits {

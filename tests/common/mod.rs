@@ -2,12 +2,14 @@
 //!
 //! Every object gets its own material (object `i` uses material `i`), which is all the
 //! analytic tests need and keeps scene construction to one list of parts.
+#![allow(dead_code)]
 
 use glam::{DVec3, Vec3};
 use lfgen::camera::LightFieldCamera;
 use lfgen::config::SliceSpacing;
 use lfgen::render::RenderScene;
-use lfgen::render::integrator::PathSettings;
+use lfgen::render::cache::RadianceCache;
+use lfgen::render::integrator::{PathSettings, Shading};
 use lfgen::render::view::{RenderSettings, ViewOutput};
 use lfgen::scene::{
     Material, Object, Opacity, SceneDesc, Shape, SliceRange, SurfaceModel, Texture, Transform,
@@ -168,5 +170,26 @@ impl Harness {
         let (cam, slices) = (&self.desc.camera, &self.desc.slices);
         self.scene
             .render_view(cam, slices, settings, view, with_gt, &AtomicU64::new(0))
+    }
+
+    /// The shared-shading cache from `spp` fill samples per pixel of every view, cells of
+    /// one pixel.
+    pub fn cache(&self, settings: &RenderSettings, spp: u32) -> RadianceCache {
+        let cam = &self.desc.camera;
+        self.scene
+            .fill_cache(cam, settings, spp, 1.0, &AtomicU64::new(0))
+    }
+
+    /// A view (no GT) with shared shading from `cache`.
+    pub fn render_shared(
+        &self,
+        view: u32,
+        settings: &RenderSettings,
+        cache: &RadianceCache,
+    ) -> ViewOutput {
+        let (cam, slices) = (&self.desc.camera, &self.desc.slices);
+        let shading = Shading::Read(cache);
+        let done = AtomicU64::new(0);
+        (self.scene).render_view_with(cam, slices, settings, view, false, shading, &done)
     }
 }
