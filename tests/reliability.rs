@@ -258,3 +258,23 @@ fn resume_with_nothing_to_do_keeps_the_readme_and_empty_entries_never_verify() {
     m.scenes[0].files.clear();
     assert!(!scene_entry_verifies(d.path(), &m.scenes[0]));
 }
+
+/// A glTF node scaled by 1e25 used to panic inside the BVH build (obvhs' quantised nodes
+/// overflow); it is refused, naming the file, before anything is built.
+#[test]
+fn a_gltf_node_scaled_beyond_any_room_is_refused_not_a_panic() {
+    let d = tmp();
+    let src = Path::new("tests/fixtures/gltf");
+    let mut doc: serde_json::Value =
+        serde_json::from_slice(&fs::read(src.join("plane.gltf")).unwrap()).unwrap();
+    doc["nodes"][1]["scale"] = serde_json::json!([1e25, 1e25, 1.0]);
+    fs::write(d.path().join("huge.gltf"), doc.to_string()).unwrap();
+    fs::copy(src.join("plane.bin"), d.path().join("plane.bin")).unwrap();
+    let out = d.path().join("out");
+    let r = render(&d.path().join("huge.gltf"), &out);
+    assert_eq!(r.status.code(), Some(1), "{}", stderr(&r));
+    failed_with(&r, "huge.gltf");
+    failed_with(&r, "matrix");
+    assert!(!stderr(&r).contains("panicked"));
+    assert!(!out.exists());
+}

@@ -97,6 +97,7 @@ pub fn write_contact_sheets(dataset: &Path) -> Result<usize> {
     std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;
     let mut rows = String::new();
     for e in &manifest.scenes {
+        lfformat::manifest::verify_scene_entry(dataset, e)?;
         let dir = dataset.join(&e.dir);
         let sheet = contact_sheet(&dir).with_context(|| format!("{}", dir.display()))?;
         let name = format!("{}.png", e.dir.replace('/', "_"));

@@ -8,6 +8,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
+use lfformat::manifest::{Manifest, verify_scene_entry};
 
 /// The file that marks a scene folder.
 pub const PARAMETERS_FILE: &str = "parameters.cfg";
@@ -48,7 +49,51 @@ pub fn discover(root: &Path, splits: &[String]) -> Result<Vec<SceneDir>> {
         );
     }
     check_unique(&scenes)?;
+    verify_against_manifest(root, &scenes)?;
     Ok(scenes)
+}
+
+/// Where the scenes belong to an lfgen dataset (a `manifest.json` at `root` or up to two
+/// folders above it), every scene must be listed in it and its files must match their
+/// checksums: a damaged file, or a stray scene folder the manifest does not describe, is an
+/// error naming it instead of a silently wrong score.
+fn verify_against_manifest(root: &Path, scenes: &[SceneDir]) -> Result<()> {
+    let root = root.canonicalize().unwrap_or_else(|_| root.to_path_buf());
+    let Some(dataset) = root
+        .ancestors()
+        .take(3)
+        .find(|d| d.join("manifest.json").is_file())
+    else {
+        return Ok(());
+    };
+    let manifest_path = dataset.join("manifest.json");
+    let manifest = Manifest::read(&manifest_path)?;
+    for scene in scenes {
+        let path = scene
+            .path
+            .canonicalize()
+            .unwrap_or_else(|_| scene.path.clone());
+        let rel = path.strip_prefix(dataset).unwrap_or(&path);
+        let rel: Vec<String> = rel
+            .components()
+            .map(|c| c.as_os_str().to_string_lossy().into_owned())
+            .collect();
+        let rel = rel.join("/");
+        let entry = manifest
+            .scenes
+            .iter()
+            .find(|e| e.dir == rel)
+            .with_context(|| {
+                format!(
+                    "{}: not listed in {} (a stray or unfinished scene): remove it, or complete \
+                 the dataset with lfgen --resume",
+                    scene.path.display(),
+                    manifest_path.display()
+                )
+            })?;
+        verify_scene_entry(dataset, entry)?;
+    }
+    Ok(())
 }
 
 /// Scenes of the split folders of `root`.
@@ -194,5 +239,52 @@ mod tests {
         );
         assert!(discover(&r.join("a"), &["a".into()]).is_err());
         assert!(discover(&r.join("missing"), &[]).is_err());
+    }
+
+    #[test]
+    fn a_manifest_is_verified_and_unlisted_scenes_are_refused() {
+        use lfformat::manifest::{FileEntry, SceneEntry, sha256_file};
+        let d = tempfile::tempdir().unwrap();
+        let r = d.path();
+        let scene = r.join("val/scene_0000");
+        make_scene(&scene);
+        std::fs::write(scene.join("gt_disp_lowres.pfm"), b"PFMDATA").unwrap();
+        let entry = |name: &str| {
+            let (sha256, bytes) = sha256_file(&scene.join(name)).unwrap();
+            FileEntry {
+                path: format!("val/scene_0000/{name}"),
+                sha256,
+                bytes,
+            }
+        };
+        let manifest = Manifest {
+            generator: "test".into(),
+            version: "0".into(),
+            config_hash: String::new(),
+            seed: 0,
+            config: serde_json::Value::Null,
+            splits: Default::default(),
+            scenes: vec![SceneEntry {
+                index: 0,
+                split: "val".into(),
+                dir: "val/scene_0000".into(),
+                files: vec![entry(PARAMETERS_FILE), entry("gt_disp_lowres.pfm")],
+            }],
+        };
+        manifest.write(&r.join("manifest.json")).unwrap();
+        assert_eq!(discover(r, &[]).unwrap().len(), 1);
+        assert_eq!(discover(&r.join("val"), &[]).unwrap().len(), 1);
+        // One flipped byte in the ground truth.
+        std::fs::write(scene.join("gt_disp_lowres.pfm"), b"PFMDATB").unwrap();
+        let e = format!("{:#}", discover(r, &[]).unwrap_err());
+        assert!(
+            e.contains("gt_disp_lowres.pfm") && e.contains("manifest"),
+            "{e}"
+        );
+        std::fs::write(scene.join("gt_disp_lowres.pfm"), b"PFMDATA").unwrap();
+        // A scene folder the manifest does not describe.
+        make_scene(&r.join("val/scene_0001"));
+        let e = format!("{:#}", discover(r, &[]).unwrap_err());
+        assert!(e.contains("scene_0001") && e.contains("not listed"), "{e}");
     }
 }

@@ -27,7 +27,12 @@ pub struct Array {
 pub struct NpzReader {
     path: PathBuf,
     archive: NpzArchive<BufReader<File>>,
+    /// `[height, width]` every image-shaped array must have (see [`Self::expect_image`]).
+    image: Option<[usize; 2]>,
 }
+
+/// Most values per pixel an image-shaped array may hold (bins, modes, components).
+const MAX_VALUES_PER_PIXEL: usize = 4096;
 
 impl NpzReader {
     /// Opens `path`.
@@ -37,7 +42,15 @@ impl NpzReader {
         Ok(Self {
             path: path.to_path_buf(),
             archive,
+            image: None,
         })
+    }
+
+    /// Arrays of two or more axes must start with `[height, width]`: checked from the header,
+    /// before any data is read, so a file claiming a huge shape is refused at once.
+    pub fn expect_image(mut self, height: usize, width: usize) -> Self {
+        self.image = Some([height, width]);
+        self
     }
 
     /// Whether the archive holds an array called `name`.
@@ -67,7 +80,13 @@ impl NpzReader {
         if npy.order() != Order::C {
             bail!("{at} is Fortran-ordered; save numpy.ascontiguousarray(a) instead");
         }
-        let shape = npy.shape().iter().map(|&n| n as usize).collect();
+        let shape: Vec<usize> = npy.shape().iter().map(|&n| n as usize).collect();
+        if let (Some([h, w]), [sh, sw, ..]) = (self.image, &shape[..]) {
+            let values = shape.iter().try_fold(1usize, |n, &d| n.checked_mul(d));
+            if (*sh, *sw) != (h, w) || values.is_none_or(|n| n > h * w * MAX_VALUES_PER_PIXEL) {
+                bail!("{at} is {sw}x{sh} (shape {shape:?}), but the ground truth is {w}x{h}");
+            }
+        }
         let data = match float_size(&npy.dtype()) {
             Some(4) => npy.into_vec::<f32>(),
             Some(8) => npy

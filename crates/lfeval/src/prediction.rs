@@ -87,7 +87,7 @@ impl Method {
             Ok(())
         };
         let posterior = optional(self.file(POSTERIOR_DIR, scene, "npz"), |p| {
-            let map = read_posterior(p)?;
+            let map = read_posterior_sized(p, Some([height, width]))?;
             size_check(p, map.width, map.height)?;
             Ok(map)
         })?;
@@ -218,7 +218,15 @@ pub fn write_posterior(path: &Path, map: &PosteriorMap) -> Result<()> {
 
 /// Reads a posterior npz; the form follows from the array names present.
 pub fn read_posterior(path: &Path) -> Result<PosteriorMap> {
+    read_posterior_sized(path, None)
+}
+
+/// [`read_posterior`], refusing from the header alone arrays that are not `[height, width]`.
+fn read_posterior_sized(path: &Path, image: Option<[usize; 2]>) -> Result<PosteriorMap> {
     let mut npz = NpzReader::open(path)?;
+    if let Some([h, w]) = image {
+        npz = npz.expect_image(h, w);
+    }
     if npz.has("probs") {
         read_discrete(&mut npz, path)
     } else if npz.has("weights") {
@@ -439,6 +447,32 @@ mod tests {
             "{err}"
         );
         assert!(Method::new(&dir.path().join("nope")).is_err());
+    }
+
+    #[test]
+    fn a_posterior_claiming_a_huge_shape_is_refused_from_its_header() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir(dir.path().join(POSTERIOR_DIR)).unwrap();
+        // An .npy header that claims 49152 × 49152 × 108 float32 (1 TB) over 16 bytes.
+        let dict = "{'descr': '<f4', 'fortran_order': False, 'shape': (49152, 49152, 108), }";
+        let mut header = dict.to_string();
+        while (10 + header.len() + 1) % 64 != 0 {
+            header.push(' ');
+        }
+        header.push('\n');
+        let mut npy = b"\x93NUMPY\x01\x00".to_vec();
+        npy.extend_from_slice(&(header.len() as u16).to_le_bytes());
+        npy.extend_from_slice(header.as_bytes());
+        npy.extend_from_slice(&[0u8; 16]);
+        let path = dir.path().join("posteriors/s.npz");
+        let mut zip = npyz::zip::ZipWriter::new(std::fs::File::create(&path).unwrap());
+        zip.start_file("probs.npy", npyz::zip::write::FileOptions::default())
+            .unwrap();
+        std::io::Write::write_all(&mut zip, &npy).unwrap();
+        zip.finish().unwrap();
+        let method = Method::new(dir.path()).unwrap();
+        let err = format!("{:#}", method.load("s", 4, 4).unwrap_err());
+        assert!(err.contains("49152") && err.contains("4x4"), "{err}");
     }
 
     #[test]

@@ -221,7 +221,7 @@ fn sparsify(
     let bad: Vec<f64> = valid
         .iter()
         .map(|&i| {
-            if diff(i).abs() > MAIN_BADPIX {
+            if crate::metrics::hci::is_bad(pred[i], gt[i], MAIN_BADPIX) {
                 100.0
             } else {
                 0.0

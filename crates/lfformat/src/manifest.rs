@@ -95,6 +95,32 @@ pub fn sha256_file(path: &Path) -> Result<(String, u64)> {
     Ok((hex, bytes))
 }
 
+/// Checks every file of `e` under `root`, naming the first that is missing, has another size
+/// or another SHA-256 (flipped bytes in a ground-truth file would otherwise score silently).
+pub fn verify_scene_entry(root: &Path, e: &SceneEntry) -> Result<()> {
+    if e.files.is_empty() {
+        return Err(Error::format(
+            &root.join(&e.dir),
+            "the manifest lists no files for this scene",
+        ));
+    }
+    for f in &e.files {
+        let path = root.join(&f.path);
+        let (hex, bytes) = sha256_file(&path)?;
+        if bytes != f.bytes || !hex.eq_ignore_ascii_case(&f.sha256) {
+            return Err(Error::format(
+                &path,
+                format!(
+                    "does not match manifest.json ({bytes} bytes, SHA-256 {hex}; the manifest \
+                     says {} bytes, {}): damaged or changed since it was generated",
+                    f.bytes, f.sha256
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Whether every file of `e` exists under `root` with the recorded size and hash. An entry
 /// without files never verifies: a scene always has some, so an empty list is damage.
 ///

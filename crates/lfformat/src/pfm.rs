@@ -87,7 +87,12 @@ pub fn decode_pfm(bytes: &[u8], path: &Path) -> Result<FloatImage> {
             }
         })
         .collect();
-    let data = flip_rows(&file_order, width).flatten().copied().collect();
+    // The HCI toolkit multiplies by |scale| (PFM's scale factor; HCI's own files use ±1).
+    let scale = header.scale.abs() as f32;
+    let data = flip_rows(&file_order, width)
+        .flatten()
+        .map(|v| if scale == 1.0 { *v } else { v * scale })
+        .collect();
     Ok(FloatImage::new(width, height, data))
 }
 
@@ -107,6 +112,8 @@ struct Header {
     width: usize,
     height: usize,
     little_endian: bool,
+    /// The scale field: its sign is the byte order, its magnitude multiplies every value.
+    scale: f64,
 }
 
 /// Splits `bytes` into the parsed header and the pixel bytes, or says what is wrong.
@@ -133,6 +140,7 @@ fn parse_header(bytes: &[u8]) -> std::result::Result<(Header, &[u8]), String> {
         width,
         height,
         little_endian: scale < 0.0,
+        scale,
     };
     Ok((header, &bytes[pos + 1..]))
 }
@@ -144,20 +152,28 @@ fn parse_field<T: std::str::FromStr>(
     name: &str,
 ) -> std::result::Result<T, String> {
     let token = next_token(bytes, pos).ok_or(format!("truncated PFM header (no {name})"))?;
-    token
-        .parse()
-        .map_err(|_| format!("bad PFM header: {name} {token:?} is not a number"))
+    token.parse().map_err(|_| {
+        // A garbage "header" can be megabytes long: show its start only.
+        let shown: String = token.chars().take(40).collect();
+        let more = if shown.len() < token.len() { "…" } else { "" };
+        format!("bad PFM header: {name} {shown:?}{more} is not a number")
+    })
 }
 
 /// The next whitespace-separated header token, or `None` at the end of the data or on
-/// non-UTF-8 bytes (both mean the header is broken).
+/// non-UTF-8 bytes (both mean the header is broken). A `#` starts a comment to the end of its
+/// line, which is skipped (some writers put one after the magic, and the toolkit reads them).
 fn next_token<'a>(bytes: &'a [u8], pos: &mut usize) -> Option<&'a str> {
-    let start = *pos
-        + bytes
-            .get(*pos..)?
-            .iter()
+    let mut start = *pos;
+    loop {
+        start += (bytes.get(start..)?.iter())
             .take_while(|b| b.is_ascii_whitespace())
             .count();
+        if bytes.get(start) != Some(&b'#') {
+            break;
+        }
+        start += bytes[start..].iter().take_while(|&&b| b != b'\n').count();
+    }
     let len = bytes[start..]
         .iter()
         .take_while(|b| !b.is_ascii_whitespace())

@@ -129,3 +129,38 @@ fn missing_file_is_an_io_error_naming_it() {
 fn new_rejects_wrong_length() {
     FloatImage::new(2, 2, vec![0.0; 3]);
 }
+
+#[test]
+fn scale_magnitude_multiplies_values_as_the_hci_toolkit_does() {
+    let mut bytes = b"Pf\n2 1\n-2.5\n".to_vec();
+    for v in [1.0f32, -4.0] {
+        bytes.extend_from_slice(&v.to_le_bytes());
+    }
+    let img = decode_pfm(&bytes, Path::new("s.pfm")).unwrap();
+    assert_eq!(img.data, vec![2.5, -10.0]);
+}
+
+#[test]
+fn comment_lines_in_the_header_are_skipped() {
+    let mut bytes = b"Pf\n# written by a tool\n2 1\n# scale next\n-1\n".to_vec();
+    for v in [1.5f32, 3.0] {
+        bytes.extend_from_slice(&v.to_le_bytes());
+    }
+    let img = decode_pfm(&bytes, Path::new("c.pfm")).unwrap();
+    assert_eq!((img.width, img.height, img.data), (2, 1, vec![1.5, 3.0]));
+}
+
+#[test]
+fn a_huge_garbage_header_is_not_echoed_whole() {
+    let mut bytes = b"Pf\n".to_vec();
+    bytes.extend(std::iter::repeat_n(b'x', 1 << 20));
+    let e = decode_pfm(&bytes, Path::new("g.pfm"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("g.pfm") && e.len() < 200,
+        "{} bytes: {}",
+        e.len(),
+        &e[..200.min(e.len())]
+    );
+}

@@ -96,11 +96,17 @@ pub fn mse_x100(pred: &[f32], gt: &[f32], frame: &Frame) -> Option<f64> {
     (n > 0).then(|| 100.0 * sum / n as f64)
 }
 
+/// Whether `|pred - gt| > t` as the HCI toolkit decides it: in float32, the difference and the
+/// threshold both rounded to it (in f64, an error within ~4e-9 of `t` could flip).
+pub fn is_bad(pred: f32, gt: f32, t: f64) -> bool {
+    (pred - gt).abs() > t as f32
+}
+
 /// `100 · #(|pred - gt| > t) / #frame` (NaN differences are not bad, as in the toolkit).
 pub fn badpix(pred: &[f32], gt: &[f32], frame: &Frame, t: f64) -> Option<f64> {
     let bad = frame
         .indices()
-        .filter(|&i| diff(pred, gt, i).abs() > t)
+        .filter(|&i| is_bad(pred[i], gt[i], t))
         .count();
     (!frame.is_empty()).then(|| 100.0 * bad as f64 / frame.len() as f64)
 }
@@ -180,6 +186,19 @@ mod tests {
         close(badpix(&pred, &gt, &frame, 0.01), 100.0 * 6.0 / 9.0);
         close(badpix(&pred, &gt, &frame, 0.03), 100.0 * 5.0 / 9.0);
         close(badpix(&pred, &gt, &frame, 0.07), 100.0 * 3.0 / 9.0);
+    }
+
+    #[test]
+    fn badpix_decides_at_the_threshold_in_float32_as_the_toolkit() {
+        // |0.07f32 - 0| is 0.0700000003 in f64, just above 0.07, but equal to float32(0.07):
+        // the toolkit's float32 comparison calls it good.
+        let frame = Frame {
+            width: 1,
+            height: 1,
+            border: 0,
+        };
+        close(badpix(&[0.07], &[0.0], &frame, 0.07), 0.0);
+        close(badpix(&[1.070_001], &[1.0], &frame, 0.07), 100.0);
     }
 
     #[test]

@@ -32,7 +32,7 @@ pub fn badpix_map(
         let e = f64::from(pred[i]) - f64::from(gt[i]);
         if !e.is_finite() {
             Rgb([0, 0, 0])
-        } else if e.abs() > t {
+        } else if crate::metrics::hci::is_bad(pred[i], gt[i], t) {
             shade(BAD)
         } else {
             shade(GOOD)
