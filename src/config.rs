@@ -166,6 +166,8 @@ pub struct RenderConfig {
     pub cache_spp: u32,
     /// Shared shading: cache cell size in pixels of the centre view at the cell's depth.
     pub cache_cell: f64,
+    /// Average library textures seen by camera rays over one sample's footprint.
+    pub texture_filter: bool,
 }
 
 impl Default for RenderConfig {
@@ -186,6 +188,7 @@ impl Default for RenderConfig {
             shading: ShadingMode::Shared,
             cache_spp: 4,
             cache_cell: 1.0,
+            texture_filter: true,
         }
     }
 }

@@ -35,6 +35,8 @@ pub struct RenderJob {
     pub shading: ShadingMode,
     pub cache_spp: u32,
     pub cache_cell: f32,
+    /// Filter library textures over a sample's footprint (see [`PathSettings::footprint`]).
+    pub texture_filter: bool,
 }
 
 impl RenderJob {
@@ -45,6 +47,7 @@ impl RenderJob {
             path: PathSettings {
                 max_depth: r.max_depth,
                 rr_depth: r.rr_depth,
+                footprint: 0.0, // per scene: see `settings`
             },
             gt_views: r.gt_views,
             mode_epsilon: r.mode_epsilon as f32,
@@ -56,6 +59,7 @@ impl RenderJob {
             shading: r.shading,
             cache_spp: r.cache_spp,
             cache_cell: r.cache_cell as f32,
+            texture_filter: r.texture_filter,
         }
     }
 
@@ -69,8 +73,16 @@ impl RenderJob {
 
     /// Per-view render settings for scene `desc`.
     pub fn settings(&self, desc: &SceneDesc) -> RenderSettings {
+        let stratum = (1.0 / (self.spp as f64).sqrt()).max(0.125);
+        let footprint = match self.texture_filter {
+            true => (stratum / desc.camera.f_px()) as f32,
+            false => 0.0,
+        };
         RenderSettings {
-            path: self.path,
+            path: PathSettings {
+                footprint,
+                ..self.path
+            },
             spp: self.spp,
             seed: desc.seed,
             scene_index: desc.index,

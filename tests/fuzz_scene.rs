@@ -166,6 +166,7 @@ fn run_in_process(v: Value) -> Outcome {
         path: PathSettings {
             max_depth: 3,
             rr_depth: 2,
+            footprint: 0.0,
         },
         spp: 1,
         seed: 0,

@@ -73,6 +73,7 @@ impl Loaded {
             path: PathSettings {
                 max_depth: 1,
                 rr_depth: 2,
+                footprint: 0.0,
             },
             spp,
             seed: 3,

@@ -25,6 +25,7 @@ use crate::camera::LightFieldCamera;
 use glam::{DVec3, I64Vec3, Vec3};
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// The grid cells of a scene: where a point's cell is, from the centre camera's footprint.
 #[derive(Clone, Copy, Debug)]
@@ -45,18 +46,25 @@ impl CacheGrid {
         }
     }
 
-    /// The cell of point `p` with shading normal `n` on material `material`.
-    pub fn key(&self, p: Vec3, n: Vec3, material: u32) -> u64 {
-        let (level, p) = self.cell_coords(p);
-        self.cell_key(level, p.floor().as_i64vec3(), n, material)
+    /// The cells of point `p` with shading normal `n` on material `material`: at the level
+    /// of its depth, then [`COARSER`] levels of twice, four times… the size (a lookup that
+    /// finds no filled cell at its own level takes the next coarser one instead).
+    pub fn keys(&self, p: Vec3, n: Vec3, material: u32) -> [u64; COARSER + 1] {
+        let level = self.level(p);
+        std::array::from_fn(|k| {
+            let level = level + k as i32;
+            let q = cell_units(p, level).floor().as_i64vec3();
+            self.cell_key(level, q, n, material)
+        })
     }
 
-    /// The level of `p`'s cells and `p` in units of their size.
-    fn cell_coords(&self, p: Vec3) -> (i32, DVec3) {
-        let p = p.as_dvec3();
-        let depth = (p - self.origin).dot(self.forward).abs().max(1e-6);
-        let level = (depth * self.cell_per_depth).log2().ceil() as i32;
-        (level, p / 2f64.powi(level))
+    /// The level of the cells at `p`'s depth.
+    fn level(&self, p: Vec3) -> i32 {
+        let depth = (p.as_dvec3() - self.origin)
+            .dot(self.forward)
+            .abs()
+            .max(1e-6);
+        (depth * self.cell_per_depth).log2().ceil() as i32
     }
 
     fn cell_key(&self, level: i32, q: I64Vec3, n: Vec3, material: u32) -> u64 {
@@ -68,6 +76,16 @@ impl CacheGrid {
         }
         h
     }
+}
+
+/// Coarser levels a fill sample also goes into: a lookup in a cell no fill sample reached
+/// (thin or grazing surfaces, where the fill's sub-pixel positions differ from the render's)
+/// then blurs over 2 or 4 cells instead of falling back to a full, noisy path per sample.
+pub const COARSER: usize = 2;
+
+/// `p` in units of the cell size of `level`.
+fn cell_units(p: Vec3, level: i32) -> DVec3 {
+    p.as_dvec3() / 2f64.powi(level)
 }
 
 /// Keys are already well-mixed hashes: hashing them again would only cost time.
@@ -97,10 +115,13 @@ pub struct CacheSums {
 }
 
 impl CacheSums {
-    pub fn add(&mut self, key: u64, value: Vec3) {
-        let cell = self.cells.entry(key).or_insert((Vec3::ZERO, 0));
-        cell.0 += value;
-        cell.1 += 1;
+    /// Adds one estimate to the cells `keys` of its point ([`CacheGrid::keys`]).
+    pub fn add(&mut self, keys: &[u64], value: Vec3) {
+        for &key in keys {
+            let cell = self.cells.entry(key).or_insert((Vec3::ZERO, 0));
+            cell.0 += value;
+            cell.1 += 1;
+        }
     }
 
     /// Adds `other`'s sums cell by cell (call in a fixed order for reproducible sums).
@@ -119,14 +140,35 @@ impl CacheSums {
             .into_iter()
             .map(|(k, (sum, n))| (k, sum / n as f32))
             .collect();
-        RadianceCache { grid, cells }
+        static NEXT_ID: AtomicU64 = AtomicU64::new(0);
+        let id = NEXT_ID.fetch_add(1, Ordering::Relaxed);
+        RadianceCache { grid, cells, id }
     }
+}
+
+/// What identifies the eight cells of a lookup (`RadianceCache::corners`); the cache's id
+/// tells two caches apart (a thread renders one scene's views after another's, and a new
+/// cache may reuse a dropped one's memory).
+#[derive(Clone, Copy, PartialEq)]
+struct Corners {
+    cache: u64,
+    level: i32,
+    base: I64Vec3,
+    normal: u8,
+    material: u32,
+}
+
+thread_local! {
+    static LAST_CORNERS: std::cell::RefCell<Option<(Corners, [Option<Vec3>; 8])>> =
+        const { std::cell::RefCell::new(None) };
 }
 
 /// The filled cache: mean coupled irradiance per cell.
 pub struct RadianceCache {
     pub grid: CacheGrid,
     cells: KeyMap<Vec3>,
+    /// Unique in the process (see [`Corners`]).
+    id: u64,
 }
 
 impl RadianceCache {
@@ -139,24 +181,59 @@ impl RadianceCache {
     /// pixel's value depend on how its samples fall among cells, which differs from view to
     /// view; the interpolated field is continuous, so views agree to its gradient.
     pub fn lookup(&self, p: Vec3, n: Vec3, material: u32) -> Option<Vec3> {
-        let (level, p) = self.grid.cell_coords(p);
-        let f = p - DVec3::splat(0.5);
+        let level = self.grid.level(p);
+        (0..=COARSER as i32).find_map(|k| self.interpolate(level + k, p, n, material))
+    }
+
+    /// The trilinear interpolation at one level, `None` where no cell around `p` is filled.
+    fn interpolate(&self, level: i32, p: Vec3, n: Vec3, material: u32) -> Option<Vec3> {
+        let f = cell_units(p, level) - DVec3::splat(0.5);
         let base = f.floor();
         let t = (f - base).as_vec3();
-        let base = base.as_i64vec3();
+        let corners = self.corners(level, base.as_i64vec3(), n, material);
         let (mut sum, mut weight) = (Vec3::ZERO, 0.0);
-        for corner in 0..8 {
-            let o = I64Vec3::new(corner & 1, (corner >> 1) & 1, corner >> 2);
+        for (corner, value) in corners.iter().enumerate() {
+            let o = [corner & 1, (corner >> 1) & 1, corner >> 2];
             let w = [0, 1, 2]
                 .map(|a| if o[a] == 1 { t[a] } else { 1.0 - t[a] })
                 .iter()
                 .product::<f32>();
-            if let Some(v) = self.get(self.grid.cell_key(level, base + o, n, material)) {
-                sum += w * v;
+            if let Some(v) = value {
+                sum += w * *v;
                 weight += w;
             }
         }
         (weight > 1e-3).then(|| sum / weight)
+    }
+
+    /// The eight cells around a lookup. The samples of a pixel (and of its neighbours) mostly
+    /// fall between the same eight cells, so the last eight are kept per thread: at 512²
+    /// the table is far larger than the CPU caches, and eight random reads per sample cost
+    /// more than the rest of the sample.
+    fn corners(&self, level: i32, base: I64Vec3, n: Vec3, material: u32) -> [Option<Vec3>; 8] {
+        let axis = n.abs().max_position();
+        let id = Corners {
+            cache: self.id,
+            level,
+            base,
+            normal: (axis as u8) << 1 | (n[axis] < 0.0) as u8,
+            material,
+        };
+        LAST_CORNERS.with(|last| {
+            let mut last = last.borrow_mut();
+            if let Some((seen, values)) = &*last
+                && *seen == id
+            {
+                return *values;
+            }
+            let values = std::array::from_fn(|corner| {
+                let c = corner as i64;
+                let o = I64Vec3::new(c & 1, (c >> 1) & 1, c >> 2);
+                self.get(self.grid.cell_key(level, base + o, n, material))
+            });
+            *last = Some((id, values));
+            values
+        })
     }
 
     /// Number of cells (reported with the render).
@@ -192,28 +269,35 @@ mod tests {
         // f_px = 100: at 2 m depth a pixel is 2 cm, so cells are 2^-5 m = 3.125 cm.
         let grid = CacheGrid::new(&camera(), 1.0);
         let n = Vec3::Z;
-        let key = |x: f32| grid.key(Vec3::new(x, 0.01, -2.0), n, 0);
+        let key = |x: f32| grid.keys(Vec3::new(x, 0.01, -2.0), n, 0)[0];
         assert_eq!(key(0.001), key(0.03));
         assert_ne!(key(0.03), key(0.032));
+        // The coarser levels: 6.25 cm and 12.5 cm.
+        let coarse = |x: f32| grid.keys(Vec3::new(x, 0.01, -2.0), n, 0);
+        assert_eq!(coarse(0.001)[1], coarse(0.06)[1]);
+        assert_ne!(coarse(0.06)[1], coarse(0.063)[1]);
+        assert_eq!(coarse(0.001)[2], coarse(0.12)[2]);
         // Another normal axis, side or material is another cell.
         let p = Vec3::new(0.01, 0.01, -2.0);
-        assert_ne!(grid.key(p, n, 0), grid.key(p, -n, 0));
-        assert_ne!(grid.key(p, n, 0), grid.key(p, Vec3::X, 0));
-        assert_ne!(grid.key(p, n, 0), grid.key(p, n, 1));
+        let k = |n: Vec3, m: u32| grid.keys(p, n, m)[0];
+        assert_ne!(k(n, 0), k(-n, 0));
+        assert_ne!(k(n, 0), k(Vec3::X, 0));
+        assert_ne!(k(n, 0), k(n, 1));
     }
 
     #[test]
     fn sums_average_per_cell_in_any_merge_grouping() {
         let mut a = CacheSums::default();
-        a.add(1, Vec3::ONE);
-        a.add(2, Vec3::splat(4.0));
+        a.add(&[1], Vec3::ONE);
+        a.add(&[2, 5], Vec3::splat(4.0));
         let mut b = CacheSums::default();
-        b.add(1, Vec3::splat(3.0));
+        b.add(&[1], Vec3::splat(3.0));
         a.merge(b);
         let cache = a.finish(CacheGrid::new(&camera(), 1.0));
         assert_eq!(cache.get(1), Some(Vec3::splat(2.0)));
         assert_eq!(cache.get(2), Some(Vec3::splat(4.0)));
         assert_eq!(cache.get(3), None);
-        assert_eq!(cache.len(), 2);
+        assert_eq!(cache.get(5), Some(Vec3::splat(4.0)));
+        assert_eq!(cache.len(), 3);
     }
 }

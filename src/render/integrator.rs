@@ -4,16 +4,23 @@
 
 use super::RenderScene;
 use super::bsdf::{Frame, Lobes, power_heuristic};
-use super::cache::{CacheGrid, RadianceCache};
+use super::cache::{COARSER, CacheGrid, RadianceCache};
 use super::geometry::Hit;
 use super::sampler::Sampler;
 use glam::Vec3;
 
-/// Path-tracing limits.
+/// Path-tracing limits, and the texture filter of camera paths.
 #[derive(Clone, Copy, Debug)]
 pub struct PathSettings {
     pub max_depth: u32,
     pub rr_depth: u32,
+    /// Width of the texture filter per metre of camera-ray length (0: no filtering). Library
+    /// textures seen by camera paths (directly or through smooth glass) are averaged over
+    /// this times the path's length — pbrt-v4's choice: a pixel's footprint scaled by
+    /// `max(1/8, 1/√spp)`, the width of one sample's stratum, so the sub-pixel samples still
+    /// integrate the pixel while the texture detail inside each stratum, which they would
+    /// only alias, is averaged instead.
+    pub footprint: f32,
 }
 
 /// Offset for spawning rays off a surface, relative to the scene scale.
@@ -42,9 +49,9 @@ pub enum Shading<'a> {
 /// What a traced path found.
 pub struct Traced {
     pub radiance: Vec3,
-    /// With [`Shading::Fill`]: the cell of the first non-delta vertex and the coupled
-    /// irradiance estimated there (none if the path never reached one).
-    pub fill: Option<(u64, Vec3)>,
+    /// With [`Shading::Fill`]: the cells (one per level) of the first non-delta vertex and the
+    /// coupled irradiance estimated there (none if the path never reached one).
+    pub fill: Option<([u64; COARSER + 1], Vec3)>,
 }
 
 impl RenderScene {
@@ -81,6 +88,8 @@ impl RenderScene {
             from: origin,
         };
         let (mut pending, mut fill) = (!matches!(shading, Shading::Independent), None);
+        // Camera-ray length so far while only delta vertices were passed (texture filter).
+        let mut camera_length = Some(0.0f32);
         // One pass more than `max_depth` vertices: the last vertex's BSDF-sampled ray only
         // picks up the light it hits, the MIS partner of that vertex's light sample (as pbrt
         // and Mitsuba do). A light sample taking all the direct light alone instead would be
@@ -97,38 +106,55 @@ impl RenderScene {
             let p = origin + dir * h.t;
             let s = &self.geometry.shading[h.tri as usize];
             let mat = &self.materials[s.material as usize];
-            let bsdf = mat.surface(self.geometry.uv(&h));
             let wo = -dir.normalize();
+            let width = camera_length.map_or(0.0, |len| {
+                let len = len + h.t * dir.length();
+                camera_length = Some(len);
+                let cos = wo.dot(self.geometry.geometric_normal(h.tri)).abs();
+                len * settings.footprint / cos.max(0.05).sqrt()
+            });
+            let bsdf = mat.surface_filtered(self.geometry.uv(&h), width);
             let frame = Frame::from_normal(self.shading_normal(&h, wo, mat.glass_ior.is_some()));
             let wo_l = frame.to_local(wo);
             let mut lobes = Lobes::All;
+            // Probability that this vertex continues by BSDF sampling (below 1 only for the
+            // glossy lobe of a cached vertex): the BSDF strategy's pdf for MIS is scaled by it.
+            let mut select = 1.0;
             if pending && !bsdf.is_delta() {
                 pending = false;
                 match shading {
                     Shading::Independent => {}
                     Shading::Fill(grid) => {
                         // From here the path estimates I(p): light before it is not part of it.
-                        fill = Some(grid.key(p, frame.n, s.material));
+                        fill = Some(grid.keys(p, frame.n, s.material));
                         (radiance, beta, lobes) = (Vec3::ZERO, Vec3::ONE, Lobes::CoupledIrradiance);
                     }
                     Shading::Read(cache) => {
                         if let Some(i) = cache.lookup(p, frame.n, s.material) {
                             radiance += beta * bsdf.diffuse_out(wo_l) * i;
-                            // The glossy lobe per view, traced as often as it matters.
+                            // The glossy lobe per view: its light sample always, its
+                            // continuation as often as the lobe matters.
                             let q = bsdf.specular_probability(wo_l);
-                            if q <= 0.0 || sampler.next_f32() >= q {
+                            if q <= 0.0 {
                                 break;
                             }
-                            (beta, lobes) = (beta / q, Lobes::Specular);
+                            (select, lobes) = (q, Lobes::Specular);
                         }
                     }
                 }
             }
             if !bsdf.is_delta() && !self.lights.is_empty() {
-                radiance += beta * self.direct_light(p, &h, &frame, wo_l, &bsdf, lobes, sampler);
+                let strategy = (lobes, select);
+                radiance += beta * self.direct_light(p, &h, &frame, wo_l, &bsdf, strategy, sampler);
             }
             if !bsdf.is_delta() && !self.punctual_lights.is_empty() {
                 radiance += beta * self.punctual_light(p, &h, &frame, wo_l, &bsdf, lobes);
+            }
+            if select < 1.0 {
+                if sampler.next_f32() >= select {
+                    break;
+                }
+                beta /= select;
             }
             let Some(bs) = bsdf.sample_lobes(wo_l, sampler.next_f32(), sampler.next2(), lobes)
             else {
@@ -138,8 +164,11 @@ impl RenderScene {
                 break;
             }
             beta *= bs.f * bs.wi.z.abs() / bs.pdf;
+            if !bs.is_delta {
+                camera_length = None;
+            }
             arrival = Arrival {
-                pdf: bs.pdf,
+                pdf: bs.pdf * select,
                 is_delta: bs.is_delta,
                 from: p,
             };
@@ -189,7 +218,8 @@ impl RenderScene {
     }
 
     /// One light sample with a shadow ray through semi-transparent surfaces, MIS-weighted
-    /// against BSDF sampling.
+    /// against BSDF sampling of `lobes`, which the path takes with probability `select`.
+    #[allow(clippy::too_many_arguments)] // the vertex's parts, as the path loop holds them
     fn direct_light(
         &self,
         p: Vec3,
@@ -197,7 +227,7 @@ impl RenderScene {
         frame: &Frame,
         wo_l: Vec3,
         bsdf: &super::bsdf::SurfaceParams,
-        lobes: Lobes,
+        (lobes, select): (Lobes, f32),
         sampler: &mut Sampler,
     ) -> Vec3 {
         let ls = self.lights.sample(
@@ -216,6 +246,7 @@ impl RenderScene {
         }
         let wi_l = frame.to_local(wi);
         let (f, bsdf_pdf) = bsdf.eval_lobes(wo_l, wi_l, lobes);
+        let bsdf_pdf = bsdf_pdf * select;
         if f == Vec3::ZERO {
             return Vec3::ZERO;
         }

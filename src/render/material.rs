@@ -57,10 +57,13 @@ pub enum ColorMap {
 }
 
 /// A procedural library texture rendered to `TEXTURE_PX`² linear texels (with the tint), so
-/// a hit costs a bilinear lookup instead of the generator's noise octaves.
+/// a hit costs a bilinear lookup instead of the generator's noise octaves, plus its mip
+/// pyramid (each level the 2×2 box average of the one below, down to one texel) for lookups
+/// filtered over a footprint.
 #[derive(Debug)]
 pub struct LibraryTile {
-    texels: Vec<Vec3>,
+    /// Level 0 is `px`² texels, level k is `(px >> k)`².
+    levels: Vec<Vec<Vec3>>,
     px: usize,
     tile_size_m: f32,
 }
@@ -69,13 +72,18 @@ impl LibraryTile {
     fn new(seed: u64, index: u32, tint: [f32; 3]) -> Self {
         let spec = TextureSpec::from_index(seed, index);
         let tint = Vec3::from(tint);
-        let texels = crate::textures::render(&spec, TEXTURE_PX)
+        let texels: Vec<Vec3> = crate::textures::render(&spec, TEXTURE_PX)
             .into_iter()
             .map(|c| c * tint)
             .collect();
+        let px = TEXTURE_PX as usize;
+        let mut levels = vec![texels];
+        while levels.last().is_some_and(|l| l.len() > 1) {
+            levels.push(downsample(levels.last().expect("non-empty")));
+        }
         Self {
-            texels,
-            px: TEXTURE_PX as usize,
+            levels,
+            px,
             tile_size_m: spec.tile_size_m,
         }
     }
@@ -83,17 +91,51 @@ impl LibraryTile {
     /// Bilinear lookup with wrap-around (the tile is seamless), UVs in metres.
     #[inline]
     fn sample(&self, uv: Vec2) -> Vec3 {
-        let n = self.px;
+        self.sample_level(0, uv)
+    }
+
+    /// The texture averaged over a footprint `width` metres wide: trilinear between the mip
+    /// levels whose texels bracket it. A footprint below one texel is the plain lookup.
+    #[inline]
+    fn sample_filtered(&self, uv: Vec2, width: f32) -> Vec3 {
+        let lod = (width * self.px as f32 / self.tile_size_m).log2();
+        if lod.is_nan() || lod <= 0.0 {
+            return self.sample(uv);
+        }
+        let top = (self.levels.len() - 1) as f32;
+        let lod = lod.min(top);
+        let l = lod.floor();
+        let fine = self.sample_level(l as usize, uv);
+        let coarse = self.sample_level((l as usize + 1).min(top as usize), uv);
+        fine.lerp(coarse, lod - l)
+    }
+
+    fn sample_level(&self, level: usize, uv: Vec2) -> Vec3 {
+        let n = (self.px >> level).max(1);
+        let texels = &self.levels[level];
         let t = (uv / self.tile_size_m).fract_gl() * n as f32 - Vec2::splat(0.5);
         let (x0, y0) = (t.x.floor(), t.y.floor());
         let (fx, fy) = (t.x - x0, t.y - y0);
         let ix = |x: f32| (x as i64).rem_euclid(n as i64) as usize;
         let (xa, xb, ya, yb) = (ix(x0), ix(x0 + 1.0), ix(y0), ix(y0 + 1.0));
-        let at = |x: usize, y: usize| self.texels[y * n + x];
+        let at = |x: usize, y: usize| texels[y * n + x];
         let top = at(xa, ya).lerp(at(xb, ya), fx);
         let bottom = at(xa, yb).lerp(at(xb, yb), fx);
         top.lerp(bottom, fy)
     }
+}
+
+/// The next mip level of a square, power-of-two level: 2×2 box averages.
+fn downsample(level: &[Vec3]) -> Vec<Vec3> {
+    let n = level.len().isqrt();
+    let m = (n / 2).max(1);
+    (0..m * m)
+        .map(|i| {
+            let (x, y) = (2 * (i % m), 2 * (i / m));
+            let at = |dx: usize, dy: usize| level[((y + dy) % n) * n + (x + dx) % n];
+            (at(0, 0) + at(1, 0) + at(0, 1) + at(1, 1)) * 0.25
+        })
+        .collect()
 }
 
 impl ColorMap {
@@ -116,6 +158,16 @@ impl ColorMap {
             ColorMap::Texture(t) => t.eval(uv),
             ColorMap::Image { image, factor } => image.sample(uv).truncate() * *factor,
             ColorMap::Tile(tile) => tile.sample(uv),
+        }
+    }
+
+    /// [`Self::eval`] averaged over a footprint `width` metres wide where the map can
+    /// (library tiles, through their mip pyramid); other maps are looked up as they are.
+    #[inline]
+    pub fn eval_filtered(&self, uv: Vec2, width: f32) -> Vec3 {
+        match self {
+            ColorMap::Tile(tile) => tile.sample_filtered(uv, width),
+            other => other.eval(uv),
         }
     }
 }
@@ -210,8 +262,15 @@ impl RenderMaterial {
     /// The BSDF at a surface point.
     #[inline]
     pub fn surface(&self, uv: Vec2) -> SurfaceParams {
+        self.surface_filtered(uv, 0.0)
+    }
+
+    /// The BSDF at a surface point, its base colour averaged over a footprint `width` metres
+    /// wide (0: the plain lookup).
+    #[inline]
+    pub fn surface_filtered(&self, uv: Vec2, width: f32) -> SurfaceParams {
         SurfaceParams {
-            base_color: self.base_color.eval(uv),
+            base_color: self.base_color.eval_filtered(uv, width),
             roughness: self.roughness,
             metallic: self.metallic,
             specular: self.specular,
@@ -224,5 +283,43 @@ impl RenderMaterial {
 
     pub fn is_emissive(&self) -> bool {
         self.emission.max_element() > 0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tile() -> LibraryTile {
+        LibraryTile::new(3, 5, [1.0, 0.9, 0.8])
+    }
+
+    fn mean(v: &[Vec3]) -> Vec3 {
+        v.iter().copied().sum::<Vec3>() / v.len() as f32
+    }
+
+    #[test]
+    fn mip_levels_halve_down_to_one_texel_and_keep_the_mean() {
+        let t = tile();
+        assert_eq!(t.levels.len(), TEXTURE_PX.ilog2() as usize + 1);
+        for (k, level) in t.levels.iter().enumerate() {
+            assert_eq!(level.len(), (t.px >> k).pow(2));
+            let d = (mean(level) - mean(&t.levels[0])).abs().max_element();
+            assert!(d < 1e-4, "level {k}: mean off by {d}");
+        }
+    }
+
+    #[test]
+    fn a_filtered_lookup_is_exact_below_a_texel_and_the_mean_over_the_tile() {
+        let t = tile();
+        let texel = t.tile_size_m / t.px as f32;
+        for uv in [Vec2::new(0.013, 0.2), Vec2::new(1.7, -0.4)] {
+            assert_eq!(t.sample_filtered(uv, 0.0), t.sample(uv));
+            assert_eq!(t.sample_filtered(uv, 0.5 * texel), t.sample(uv));
+            let whole = t.sample_filtered(uv, 10.0 * t.tile_size_m);
+            assert!((whole - mean(&t.levels[0])).abs().max_element() < 1e-4);
+            // Two texels wide: exactly level 1.
+            assert!((t.sample_filtered(uv, 2.0 * texel) - t.sample_level(1, uv)).length() < 1e-5);
+        }
     }
 }

@@ -151,8 +151,8 @@ impl RenderScene {
                 (self.geometry).closest(&self.materials, ray.origin, ray.dir, f32::INFINITY, key);
             let fill = Shading::Fill(grid);
             let traced = self.trace(&s.path, ray.origin, ray.dir, first, &mut sampler, fill);
-            if let Some((cell, value)) = traced.fill {
-                sums.add(cell, value);
+            if let Some((cells, value)) = traced.fill {
+                sums.add(&cells, value);
             }
         }
     }

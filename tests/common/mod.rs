@@ -144,6 +144,7 @@ pub fn settings(spp: u32, max_depth: u32) -> RenderSettings {
         path: PathSettings {
             max_depth,
             rr_depth: max_depth + 1,
+            footprint: 0.0,
         },
         spp,
         seed: 11,

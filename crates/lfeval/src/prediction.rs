@@ -456,7 +456,7 @@ mod tests {
         // An .npy header that claims 49152 × 49152 × 108 float32 (1 TB) over 16 bytes.
         let dict = "{'descr': '<f4', 'fortran_order': False, 'shape': (49152, 49152, 108), }";
         let mut header = dict.to_string();
-        while (10 + header.len() + 1) % 64 != 0 {
+        while !(10 + header.len() + 1).is_multiple_of(64) {
             header.push(' ');
         }
         header.push('\n');

@@ -45,7 +45,7 @@ use placement::{excluded, hood_elevation, surfaces};
 use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 use std::fmt;
 use std::fs;
-use std::io::{Read, Write};
+use std::io::Read;
 use std::path::{Path, PathBuf};
 
 /// The Debian packages downloaded, furniture libraries first.
@@ -695,25 +695,17 @@ fn attribution(libraries: &[Library], credits: &[Credit]) -> String {
     s
 }
 
-/// Writes `bytes` to `path` through a temporary file and a rename.
+/// Writes `bytes` to `path` through a temporary file of this process and a rename.
 fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".tmp");
-    let tmp = PathBuf::from(tmp);
-    let written = fs::File::create(&tmp).and_then(|mut f| {
-        f.write_all(bytes)?;
-        f.sync_all()
-    });
-    written.with_context(|| format!("cannot write {}", tmp.display()))?;
-    fs::rename(&tmp, path).with_context(|| format!("cannot rename to {}", path.display()))
+    Ok(lfformat::files::write_atomic(path, bytes)?)
 }
 
-/// Writes `bytes` to `path`, creating its folders on the way.
+/// Writes `bytes` to `path` (checked and synced), creating its folders on the way.
 fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
     if let Some(dir) = path.parent() {
         fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     }
-    fs::write(path, bytes).with_context(|| format!("cannot write {}", path.display()))
+    Ok(lfformat::files::write_file(path, bytes)?)
 }
 
 #[cfg(test)]
@@ -721,6 +713,7 @@ mod tests {
     use super::debian::PLUGIN_CATALOG;
     use super::*;
     use crate::catalog::AssetPlacement;
+    use std::io::Write;
 
     /// A `.sh3f` written in the test, converted field by field.
     #[test]
