@@ -82,6 +82,12 @@ struct Band {
 /// Salt of the fill pass's sample streams, so they are not the render's own.
 const FILL_STREAM: u64 = 0xF111_CACE;
 
+/// Stream offset of a pixel's path decisions. Pixel positions and stochastic-transparency keys
+/// come from the pixel's camera stream alone, so the ground truth (built from those rays) is the
+/// same whatever the shading mode draws along the path: an independent render and a shared one
+/// write byte-identical `modes.exr`.
+const PATH_STREAM: u64 = 0xA7B5_7EA3;
+
 impl RenderScene {
     /// Renders `view` with the independent estimator; `samples_done` counts camera samples
     /// for progress reporting.
@@ -257,7 +263,9 @@ struct PixelCtx<'a> {
 impl PixelCtx<'_> {
     fn render(&self, with_gt: bool, scratch: &mut Scratch, band: &mut Band) {
         let s = self.settings;
-        let mut sampler = Sampler::new(s.seed, s.scene_index, self.view, self.x, self.y, s.spp);
+        let (view, x, y) = (self.view, self.x, self.y);
+        let mut camera = Sampler::new(s.seed, s.scene_index, view, x, y, s.spp);
+        let mut sampler = Sampler::new(s.seed, s.scene_index ^ PATH_STREAM, view, x, y, 1);
         let mut sum = Vec3::ZERO;
         let centre = self.centre;
         if with_gt {
@@ -270,9 +278,9 @@ impl PixelCtx<'_> {
             );
         }
         for i in 0..s.spp {
-            let off = sampler.pixel_offset(i);
+            let off = camera.pixel_offset(i);
             let ray = self.rays.ray(self.x as f32 + off.x, self.y as f32 + off.y);
-            let key = sampler.next_key();
+            let key = camera.next_key();
             sum += if with_gt {
                 self.sample_with_gt(ray.origin, ray.dir, key, &mut sampler, scratch)
             } else {

@@ -181,16 +181,17 @@ impl Harness {
             .fill_cache(cam, settings, spp, 1.0, &AtomicU64::new(0))
     }
 
-    /// A view (no GT) with shared shading from `cache`.
+    /// A view with shared shading from `cache`.
     pub fn render_shared(
         &self,
         view: u32,
         settings: &RenderSettings,
         cache: &RadianceCache,
+        with_gt: bool,
     ) -> ViewOutput {
         let (cam, slices) = (&self.desc.camera, &self.desc.slices);
         let shading = Shading::Read(cache);
         let done = AtomicU64::new(0);
-        (self.scene).render_view_with(cam, slices, settings, view, false, shading, &done)
+        (self.scene).render_view_with(cam, slices, settings, view, with_gt, shading, &done)
     }
 }
