@@ -336,6 +336,31 @@ pub const MAX_SPP: u32 = 1 << 16;
 pub const MAX_SLICES: u32 = 4096;
 /// Longest path.
 pub const MAX_DEPTH: u32 = 1024;
+/// Largest room side: scene descriptions hold positions up to 1e6 m, and a room far larger
+/// than any real one only hides a typo.
+pub const MAX_ROOM_M: f64 = 1000.0;
+/// Largest environment or daylight radiance (the sun's luminance is about 1.6e9 cd/m², but
+/// scenes are exposed for interiors; 1e6 leaves products of radiances finite in f32).
+pub const MAX_RADIANCE: f64 = 1e6;
+/// Most pieces drawn per room (each is a placement attempt; 48 by default).
+pub const MAX_OBJECTS: u32 = 10_000;
+/// Most ceiling lights per room.
+pub const MAX_LIGHTS: u32 = 1024;
+/// Largest texture library (each texture is a 768 KiB tile when used).
+pub const MAX_TEXTURES: u32 = 100_000;
+
+/// Where a config's values came from, for its errors: the file (or the defaults) and every
+/// preset and `--set` applied over it, so a bad `--set` is not blamed on the defaults.
+fn origin(path: Option<&Path>, presets: &[String], sets: &[String]) -> String {
+    let mut origin = path.map_or("built-in defaults".into(), |p| p.display().to_string());
+    for p in presets {
+        origin += &format!(" + --preset {p}");
+    }
+    for s in sets {
+        origin += &format!(" + --set {s}");
+    }
+    origin
+}
 
 impl Config {
     /// Loads `path` (or the built-in defaults when `None`), then applies presets and overrides.
@@ -361,7 +386,7 @@ impl Config {
         for s in sets {
             apply_set(&mut table, s)?;
         }
-        let origin = path.map_or("built-in defaults".into(), |p| p.display().to_string());
+        let origin = origin(path, presets, sets);
         let cfg: Config = table
             .try_into()
             .with_context(|| format!("{origin}: invalid config"))?;
@@ -399,6 +424,18 @@ impl Config {
         ];
         if positive.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
             bail!("camera focal length, sensor size, baseline and focus must be positive");
+        }
+        let fov = 2.0
+            * (0.5 * c.sensor_size_mm / c.focal_length_mm)
+                .atan()
+                .to_degrees();
+        if !(0.1..=170.0).contains(&fov) {
+            bail!(
+                "camera.focal_length_mm {} and sensor_size_mm {} give a {fov:.3}° field of view: \
+                 it must be 0.1° to 170°",
+                c.focal_length_mm,
+                c.sensor_size_mm
+            );
         }
         let r = &self.render;
         if r.spp == 0 || r.slices == 0 || r.max_depth == 0 {
@@ -449,9 +486,38 @@ impl SceneConfig {
         ];
         if ranges
             .iter()
-            .any(|[a, b]| !(a.is_finite() && *a > 0.0 && a <= b))
+            .any(|[a, b]| !(a.is_finite() && b.is_finite() && *a > 0.0 && a <= b))
         {
             bail!("scene ranges must be positive [min, max] pairs");
+        }
+        let rooms = [self.room_width, self.room_depth, self.room_height];
+        if rooms.iter().flatten().any(|&m| m > MAX_ROOM_M) {
+            bail!(
+                "scene.room_width, room_depth and room_height must be at most {MAX_ROOM_M} m, \
+                 got {:?}, {:?}, {:?}",
+                self.room_width,
+                self.room_depth,
+                self.room_height
+            );
+        }
+        if self
+            .environment
+            .iter()
+            .any(|v| !(0.0..=MAX_RADIANCE).contains(v))
+        {
+            bail!(
+                "scene.environment must be 0 to {MAX_RADIANCE}, got {:?}",
+                self.environment
+            );
+        }
+        if self.objects > MAX_OBJECTS || self.lights > MAX_LIGHTS || self.textures > MAX_TEXTURES {
+            bail!(
+                "scene.objects (≤ {MAX_OBJECTS}), scene.lights (≤ {MAX_LIGHTS}) or scene.textures \
+                 (≤ {MAX_TEXTURES}) is too large: {}, {}, {}",
+                self.objects,
+                self.lights,
+                self.textures
+            );
         }
         if self.textures < 14 {
             bail!("scene.textures must be at least 14 (one per texture family)");
@@ -464,7 +530,7 @@ impl SceneConfig {
             bail!("scene.windows must be [min, max] with min <= max <= 4");
         }
         let [a, b] = self.window_light;
-        if !((0.0..=1.0).contains(&self.door) && a.is_finite() && 0.0 <= a && a <= b) {
+        if !((0.0..=1.0).contains(&self.door) && b <= MAX_RADIANCE && 0.0 <= a && a <= b) {
             bail!("scene.door must lie in [0, 1] and scene.window_light be a [min, max] range");
         }
         if !(0.0..=1.0).contains(&self.catalog_share) {
