@@ -211,6 +211,14 @@ impl Default for TrainConfig {
     }
 }
 
+/// Largest training crop side (scenes themselves are at most 16384²).
+pub const MAX_PATCH: usize = 4096;
+/// Most modes a target keeps (lfgen writes at most a few dozen).
+pub const MAX_MODES: usize = 1024;
+/// Most pixels in one batch: 3.5× the thesis' 512 × 96², about 7 GB of inputs with 9 × 4 views
+/// — a typo such as `batch = 1e9` is refused before it allocates.
+pub const MAX_BATCH_PIXELS: usize = 1 << 24;
+
 impl TrainConfig {
     /// Reads a TOML file; missing fields keep their defaults, unknown ones are errors.
     pub fn read(path: &Path) -> Result<Self> {
@@ -233,6 +241,21 @@ impl TrainConfig {
     pub fn validate(&self) -> Result<()> {
         if self.patch < 2 || self.batch == 0 || self.max_modes == 0 {
             bail!("patch must be ≥ 2, batch and max_modes ≥ 1");
+        }
+        if self.patch > MAX_PATCH || self.max_modes > MAX_MODES {
+            bail!(
+                "patch must be at most {MAX_PATCH} and max_modes at most {MAX_MODES}, got {} and {}",
+                self.patch,
+                self.max_modes
+            );
+        }
+        if self.batch.saturating_mul(self.patch * self.patch) > MAX_BATCH_PIXELS {
+            bail!(
+                "batch × patch² = {} × {}² is over {MAX_BATCH_PIXELS} pixels per batch \
+                 (the thesis' 512 × 96² is 4.7 M): lower batch or patch",
+                self.batch,
+                self.patch
+            );
         }
         if self.net.stream_width == 0 || self.net.head_width == 0 {
             bail!("network widths must be ≥ 1");
@@ -303,5 +326,21 @@ mod tests {
         assert_eq!(back, cfg);
         let bad: TrainConfig = toml::from_str("lr_decay = 0.0").unwrap();
         assert!(bad.validate().is_err());
+    }
+
+    #[test]
+    fn huge_batches_and_patches_are_refused_before_they_allocate() {
+        let with = |text: &str| {
+            let cfg: TrainConfig = toml::from_str(text).unwrap();
+            cfg.validate().map_err(|e| e.to_string())
+        };
+        assert!(with("batch = 512\npatch = 96").is_ok());
+        assert!(with("batch = 1000000000").unwrap_err().contains("batch"));
+        assert!(with("patch = 100000").unwrap_err().contains("patch"));
+        assert!(
+            with("batch = 2048\npatch = 96")
+                .unwrap_err()
+                .contains("pixels")
+        );
     }
 }

@@ -76,6 +76,20 @@ impl Drop for Loader {
     }
 }
 
+/// Refuses a scene smaller than the training crop, naming both (a crop cannot be drawn from
+/// it; the thesis' 96² patches need scenes of at least 96², so the quick preset's 128² fits).
+fn fits_patch(scene: &Scene, patch: usize) -> Result<()> {
+    let (w, h) = (scene.lf.width, scene.lf.height);
+    if w < patch || h < patch {
+        bail!(
+            "{}: the scene is {w}x{h}, smaller than the {patch}x{patch} training patch \
+             (lower `patch` or render larger scenes)",
+            scene.dir.display()
+        );
+    }
+    Ok(())
+}
+
 /// The loader thread: fills the pool, then sends batches until the receiver is gone.
 fn run(
     dirs: Vec<SceneDir>,
@@ -85,7 +99,11 @@ fn run(
     tx: SyncSender<Result<Batch>>,
 ) {
     let mut rng = Pcg32::new(cfg.seed, stream);
-    let load = |d: &SceneDir| Scene::load(&d.path, &d.name, cfg.target_modes());
+    let load = |d: &SceneDir| {
+        let scene = Scene::load(&d.path, &d.name, cfg.target_modes())?;
+        fits_patch(&scene, cfg.patch)?;
+        Ok(scene)
+    };
     let initial: Vec<&SceneDir> = dirs.iter().take(pool_cfg.scenes.max(1)).collect();
     let mut pool = match initial
         .into_par_iter()

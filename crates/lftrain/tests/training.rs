@@ -356,3 +356,37 @@ fn frozen_batch_norm_trains_like_inference_and_keeps_its_statistics() {
     })));
     assert!(close(&before, &after), "frozen statistics moved");
 }
+
+/// A crop larger than the scenes is refused up front, naming the scene and both sizes (it
+/// used to be accepted and fail inside the crop).
+#[test]
+fn a_patch_larger_than_the_scenes_is_refused_naming_the_scene() {
+    use lftrain::loader::PoolConfig;
+    use lftrain::train::{TrainArgs, train};
+
+    let tmp = tempfile::tempdir().unwrap();
+    tiny_dataset(tmp.path());
+    let cfg = TrainConfig {
+        patch: 32,
+        batch: 1,
+        steps: 1,
+        ..cfg(ModelKind::Base)
+    };
+    let args = TrainArgs {
+        train: tmp.path().join("train"),
+        val: None,
+        out: tmp.path().join("run"),
+        resume: false,
+        quiet: true,
+        pool: PoolConfig {
+            scenes: 2,
+            refresh: 1,
+        },
+        steps: None,
+    };
+    let err = format!("{:#}", train(cfg, &args).unwrap_err());
+    assert!(
+        err.contains("24x24") && err.contains("32x32") && err.contains("train/"),
+        "{err}"
+    );
+}
