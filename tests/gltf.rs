@@ -379,6 +379,97 @@ fn ignored_extensions_and_maps_and_an_aspect_mismatch_are_warned_once() {
     );
 }
 
+/// `plane.gltf` with `uris.len()` images (one per entry of `uris`), each the base colour of
+/// its own material on its own copy of the wall.
+fn many_images(dir: &Path, uris: &[&str]) -> PathBuf {
+    fs::copy(fixture("plane.bin"), dir.join("plane.bin")).unwrap();
+    let mut json: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(fixture("plane.gltf")).unwrap()).unwrap();
+    let n = uris.len();
+    json["images"] = uris
+        .iter()
+        .map(|u| serde_json::json!({ "uri": u }))
+        .collect();
+    json["textures"] = (0..n).map(|i| serde_json::json!({ "source": i })).collect();
+    let material = json["materials"][0].clone();
+    let mesh = json["meshes"][0].clone();
+    let wall = json["nodes"][1].clone();
+    let (mut materials, mut meshes, mut nodes) = (vec![], vec![], vec![]);
+    for i in 0..n {
+        let mut m = material.clone();
+        m["pbrMetallicRoughness"]["baseColorTexture"] = serde_json::json!({ "index": i });
+        materials.push(m);
+        let mut mesh = mesh.clone();
+        mesh["primitives"][0]["material"] = serde_json::json!(i);
+        meshes.push(mesh);
+        let mut node = wall.clone();
+        node["mesh"] = serde_json::json!(i);
+        node["translation"] = serde_json::json!([0.0, 0.0, -2.0 - 0.01 * i as f64]);
+        nodes.push(node);
+    }
+    json["materials"] = materials.into();
+    json["meshes"] = meshes.into();
+    nodes.push(json["nodes"][0].clone());
+    json["scenes"][0]["nodes"] = (0..nodes.len()).collect();
+    json["nodes"] = nodes.into();
+    let path = dir.join("images.gltf");
+    fs::write(&path, json.to_string()).unwrap();
+    path
+}
+
+/// Six glTF images naming one file are decoded once and share one allocation; the total of
+/// distinct images is held to a budget, refused with an error naming the file when exceeded.
+#[test]
+fn images_naming_one_file_are_decoded_once_and_the_total_is_bounded() {
+    use lfgen::scene::assets::{Assets, Source};
+    let tmp = tempfile::tempdir().unwrap();
+    fs::copy(fixture("mask.png"), tmp.path().join("mask.png")).unwrap();
+    fs::copy(fixture("mask.png"), tmp.path().join("copy.png")).unwrap();
+    let one = image::open(fixture("mask.png")).unwrap();
+    let one = one.width() as u64 * one.height() as u64 * 4;
+
+    let same = many_images(
+        tmp.path(),
+        &[
+            "mask.png",
+            "./mask.png",
+            "mask.png",
+            "mask.png",
+            "mask.png",
+            "mask.png",
+        ],
+    );
+    let imported = import(&same, &config([24, 20])).unwrap();
+    assert_eq!(
+        imported.assets.image_bytes(),
+        one,
+        "six references, one image"
+    );
+    let open = |desc: &SceneDesc| {
+        let files: Vec<Source> = desc
+            .sources
+            .iter()
+            .map(|s| Source::open_unchanged(s).unwrap())
+            .collect();
+        files
+    };
+    let files = open(&imported.desc);
+    assert!(Assets::from_files_within(&imported.desc, &files, one).is_ok());
+
+    let two = many_images(tmp.path(), &["mask.png", "copy.png"]);
+    let imported = import(&two, &config([24, 20])).unwrap();
+    assert_eq!(imported.assets.image_bytes(), 2 * one);
+    let files = open(&imported.desc);
+    let err = Assets::from_files_within(&imported.desc, &files, one + one / 2)
+        .err()
+        .expect("two images over a budget of one and a half");
+    let err = format!("{err:#}");
+    assert!(
+        err.contains("images.gltf") && err.contains("decoded"),
+        "{err}"
+    );
+}
+
 /// sRGB code → linear (IEC 61966-2-1), written out here independently of the crate.
 fn srgb(code: u8) -> f64 {
     let c = code as f64 / 255.0;

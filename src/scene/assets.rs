@@ -7,7 +7,7 @@ use super::obj::ObjFile;
 use super::shapes::MeshTri;
 use super::texture_image::{ImageMap, TextureImage};
 use super::{Material, Opacity, SceneDesc, Shape, SourceFile, Texture};
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, ensure};
 use std::collections::BTreeMap;
 use std::collections::btree_map::Entry;
 use std::sync::Arc;
@@ -42,11 +42,17 @@ impl MeshKey {
     }
 }
 
+/// Most decoded texel bytes one scene may hold (four 16384² RGBA images): images are checked
+/// one at a time against their own limit, so without a total a file naming many large images
+/// (or one image many times) could take all memory.
+pub const MAX_IMAGE_BYTES: u64 = 4 << 30;
+
 /// Loaded meshes and images of a scene (empty for the built-in generator's scenes).
 #[derive(Default)]
 pub struct Assets {
     meshes: BTreeMap<MeshKey, Vec<MeshTri>>,
     images: BTreeMap<(u32, u32), Arc<TextureImage>>,
+    image_bytes: u64,
 }
 
 impl Assets {
@@ -64,6 +70,17 @@ impl Assets {
     /// Loads what `desc` refers to from its already opened source files (`files[i]` is source
     /// `i`).
     pub fn from_files(desc: &SceneDesc, files: &[Source]) -> Result<Self> {
+        Self::from_files_within(desc, files, MAX_IMAGE_BYTES)
+    }
+
+    /// [`Assets::from_files`] with at most `image_budget` decoded texel bytes. Images that are
+    /// the same data (glTF images naming one file or one buffer view) are decoded once and
+    /// count once.
+    pub fn from_files_within(
+        desc: &SceneDesc,
+        files: &[Source],
+        image_budget: u64,
+    ) -> Result<Self> {
         let file = |source: u32| {
             files
                 .get(source as usize)
@@ -76,13 +93,38 @@ impl Assets {
                 slot.insert(file.primitive_triangles(key)?);
             }
         }
+        let mut decoded: BTreeMap<(u32, String), Arc<TextureImage>> = BTreeMap::new();
         for map in desc.materials.iter().flat_map(image_maps) {
             if let Entry::Vacant(slot) = assets.images.entry((map.source, map.image)) {
-                let image = file(map.source)?.texture_image(map.image)?;
-                slot.insert(Arc::new(image));
+                let src = file(map.source)?;
+                let same = (map.source, src.image_identity(map.image)?);
+                let image = match decoded.entry(same) {
+                    Entry::Occupied(e) => e.get().clone(),
+                    Entry::Vacant(e) => {
+                        let image = Arc::new(src.texture_image(map.image)?);
+                        assets.image_bytes += image.texel_bytes();
+                        ensure!(
+                            assets.image_bytes <= image_budget,
+                            "the scene's images take over {} MiB decoded (image {} of {}): \
+                             use fewer or smaller textures",
+                            image_budget >> 20,
+                            map.image,
+                            desc.sources
+                                .get(map.source as usize)
+                                .map_or("?", |s| s.path.as_str())
+                        );
+                        e.insert(image).clone()
+                    }
+                };
+                slot.insert(image);
             }
         }
         Ok(assets)
+    }
+
+    /// Decoded texel bytes of the scene's distinct images.
+    pub fn image_bytes(&self) -> u64 {
+        self.image_bytes
     }
 
     /// Mesh-space triangles of a mesh primitive.
@@ -142,6 +184,15 @@ impl Source {
         match self {
             Source::Gltf(f) => f.texture_image(image),
             Source::Obj(f) => f.texture_image(image),
+        }
+    }
+
+    /// What image `image` is made of: equal for two images of the file that decode the same
+    /// data (an OBJ's textures are numbered per distinct file already).
+    fn image_identity(&self, image: u32) -> Result<String> {
+        match self {
+            Source::Gltf(f) => f.image_identity(image),
+            Source::Obj(_) => Ok(format!("texture {image}")),
         }
     }
 }

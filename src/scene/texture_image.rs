@@ -140,6 +140,11 @@ impl TextureImage {
         }
     }
 
+    /// Bytes the texels take.
+    pub fn texel_bytes(&self) -> u64 {
+        self.texels.len() as u64 * 4
+    }
+
     pub fn is_opaque(&self) -> bool {
         self.opaque
     }

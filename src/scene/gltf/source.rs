@@ -187,6 +187,27 @@ impl GltfFile {
         TextureImage::decode(&bytes, &what)
     }
 
+    /// What image `index` decodes: its buffer view, or the file or data URI it names (two
+    /// images with equal identities are the same texels).
+    pub fn image_identity(&self, index: u32) -> Result<String> {
+        let image = self
+            .doc
+            .images()
+            .nth(index as usize)
+            .with_context(|| format!("image {index} does not exist"))?;
+        Ok(match image.source() {
+            ::gltf::image::Source::View { view, .. } => format!("view {}", view.index()),
+            ::gltf::image::Source::Uri { uri, .. } if uri.starts_with("data:") => {
+                format!("data {}", hex_sha256(uri.as_bytes()))
+            }
+            ::gltf::image::Source::Uri { uri, .. } => {
+                let path = local_path(&self.dir, uri).with_context(|| format!("image {index}"))?;
+                let path = std::fs::canonicalize(&path).unwrap_or(path);
+                format!("file {}", path.display())
+            }
+        })
+    }
+
     /// The contents of a buffer or image URI; external files are logged with their checksum.
     fn read_uri(&self, uri: &str, what: &str) -> Result<Vec<u8>> {
         if let Some(rest) = uri.strip_prefix("data:") {
