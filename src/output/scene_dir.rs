@@ -14,7 +14,7 @@ use glam::Vec3;
 use lfformat::lock::Lock;
 use lfformat::manifest::{FileEntry, sha256_file};
 use lfformat::modes::write_modes_exr;
-use lfformat::mpi::{Mpi, write_mpi_npz};
+use lfformat::mpi::{LOADER_LAYERS, Mpi, write_mpi_npz};
 use lfformat::params::hci_disp_bounds;
 use lfformat::pfm::{FloatImage, write_pfm};
 use lfformat::{HciParameters, ModeMap};
@@ -124,7 +124,7 @@ impl SceneWriter {
             suffixes.push(String::new());
             write_mpi_npz(
                 &self.path("gt_mpi_lowres.npz"),
-                &Mpi::from_modes(gt.modes, Some(gt.colors)),
+                &Mpi::from_modes(gt.modes, Some(gt.colors), LOADER_LAYERS),
             )?;
         }
         if per_view {

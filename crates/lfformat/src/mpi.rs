@@ -20,6 +20,11 @@ use crate::modes::ModeMap;
 /// Values per layer: `R, G, B, η, disparity`.
 pub const CHANNELS: usize = 5;
 
+/// Layers the thesis' training loader keeps (`mpi[..., :12]`). It batches crops of different
+/// scenes together, so every scene must give it the same `L`: writers pad to at least this
+/// many layers (NaN), and a scene with more is cut to these by the loader itself.
+pub const LOADER_LAYERS: usize = 12;
+
 /// Name of the array inside the npz archive.
 const KEY: &str = "mpi";
 
@@ -37,7 +42,8 @@ pub struct Mpi {
 }
 
 impl Mpi {
-    /// Lays out `map` with `L = map.slot_count()` layers, using the over-operator `η`
+    /// Lays out `map` with `L = max(map.slot_count(), min_layers)` layers (pass
+    /// [`LOADER_LAYERS`] for files the thesis' loader reads), using the over-operator `η`
     /// (the thesis' definition) as the weight.
     ///
     /// `colours`, when given, holds the linear RGB of each mode's slice, one entry per mode in
@@ -48,7 +54,7 @@ impl Mpi {
     ///
     /// # Panics
     /// If `map` is incomplete or `colours` has the wrong length.
-    pub fn from_modes(map: &ModeMap, colours: Option<&[[f32; 3]]>) -> Self {
+    pub fn from_modes(map: &ModeMap, colours: Option<&[[f32; 3]]>, min_layers: usize) -> Self {
         assert!(map.is_complete(), "Mpi::from_modes: incomplete ModeMap");
         if let Some(c) = colours {
             assert_eq!(
@@ -57,7 +63,7 @@ impl Mpi {
                 "Mpi::from_modes: one colour per mode"
             );
         }
-        let layers = map.slot_count();
+        let layers = map.slot_count().max(min_layers);
         let mut data = vec![f32::NAN; map.width * map.height * layers * CHANNELS];
         let mut mode_index = 0;
         for (pixel, modes) in map.pixels().enumerate() {

@@ -4,7 +4,7 @@
 use std::io::Read;
 use std::path::Path;
 
-use lfformat::mpi::{CHANNELS, Mpi, read_mpi_npz, write_mpi_npz};
+use lfformat::mpi::{CHANNELS, LOADER_LAYERS, Mpi, read_mpi_npz, write_mpi_npz};
 use lfformat::{Error, Mode, ModeMap};
 use npyz::WriterBuilder;
 use npyz::npz::NpzWriter;
@@ -84,7 +84,7 @@ fn same_bits(a: &[f32], b: &[f32]) -> bool {
 #[test]
 fn from_modes_lays_out_layers_colours_and_nan_padding() {
     let map = sample_map();
-    let mpi = Mpi::from_modes(&map, Some(&colours(&map)));
+    let mpi = Mpi::from_modes(&map, Some(&colours(&map)), 0);
     assert_eq!((mpi.width, mpi.height, mpi.layers), (2, 3, 2));
     assert_eq!(mpi.data.len(), 2 * 3 * 2 * CHANNELS);
     // Push order: (0,0) none, (1,0) one [mode 0], (0,1) one [1], (1,1) two [2, 3].
@@ -92,8 +92,30 @@ fn from_modes_lays_out_layers_colours_and_nan_padding() {
     assert_eq!(mpi.get(1, 0, 0), [0.0, 0.0, 0.0, 0.5, 1.0]);
     assert!(mpi.get(1, 0, 1).iter().all(|v| v.is_nan()));
     assert!(mpi.get(0, 0, 0).iter().all(|v| v.is_nan()));
-    let uncoloured = Mpi::from_modes(&map, None);
+    let uncoloured = Mpi::from_modes(&map, None, 0);
     assert_eq!(uncoloured.get(1, 1, 1), [0.0, 0.0, 0.0, 0.5, 11.25]);
+}
+
+/// Files for the thesis' loader have at least its 12 layers whatever the scene's mode count
+/// (it batches scenes together, so one shape for all), the extra layers NaN, the real ones
+/// unchanged.
+#[test]
+fn from_modes_pads_to_the_loaders_twelve_layers() {
+    let map = sample_map();
+    let bare = Mpi::from_modes(&map, Some(&colours(&map)), 0);
+    let padded = Mpi::from_modes(&map, Some(&colours(&map)), LOADER_LAYERS);
+    assert_eq!((padded.width, padded.height, padded.layers), (2, 3, 12));
+    for (x, y) in [(0, 0), (1, 0), (0, 1), (1, 1), (0, 2), (1, 2)] {
+        for l in 0..12 {
+            let v = padded.get(x, y, l);
+            match l < bare.layers {
+                true => assert!(same_bits(&v, &bare.get(x, y, l))),
+                false => assert!(v.iter().all(|c| c.is_nan()), "({x}, {y}) layer {l}"),
+            }
+        }
+    }
+    // A floor below the mode count drops nothing.
+    assert_eq!(Mpi::from_modes(&map, None, 1).layers, 2);
 }
 
 #[test]
@@ -101,7 +123,7 @@ fn npz_on_disk_is_c_order_float32_bottom_up() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("gt_mpi_lowres.npz");
     let map = sample_map();
-    let mpi = Mpi::from_modes(&map, Some(&colours(&map)));
+    let mpi = Mpi::from_modes(&map, Some(&colours(&map)), 0);
     write_mpi_npz(&path, &mpi).unwrap();
     let (header, data) = raw_npy(&path);
     assert!(header.contains("'descr': '<f4'"), "{header}");
@@ -122,7 +144,7 @@ fn npz_round_trip() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("gt_mpi_lowres.npz");
     let map = sample_map();
-    let mpi = Mpi::from_modes(&map, Some(&colours(&map)));
+    let mpi = Mpi::from_modes(&map, Some(&colours(&map)), 0);
     write_mpi_npz(&path, &mpi).unwrap();
     let back = read_mpi_npz(&path).unwrap();
     assert_eq!((back.width, back.height, back.layers), (2, 3, 2));
@@ -172,7 +194,7 @@ fn corrupt_or_truncated_archives_are_format_errors() {
     std::fs::write(&path, b"not a zip archive at all").unwrap();
     format_error_text(&path);
     let map = sample_map();
-    write_mpi_npz(&path, &Mpi::from_modes(&map, None)).unwrap();
+    write_mpi_npz(&path, &Mpi::from_modes(&map, None, 0)).unwrap();
     let bytes = std::fs::read(&path).unwrap();
     std::fs::write(&path, &bytes[..bytes.len() - 30]).unwrap();
     format_error_text(&path);
@@ -186,7 +208,7 @@ fn numpy_reads_shape_dtype_and_flip() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("gt_mpi_lowres.npz");
     let map = sample_map();
-    write_mpi_npz(&path, &Mpi::from_modes(&map, Some(&colours(&map)))).unwrap();
+    write_mpi_npz(&path, &Mpi::from_modes(&map, Some(&colours(&map)), 0)).unwrap();
     let script = "import sys, numpy as np\n\
         a = np.load(sys.argv[1])['mpi']\n\
         assert a.dtype == np.float32 and a.shape == (3, 2, 2, 5), (a.dtype, a.shape)\n\
