@@ -296,6 +296,23 @@ fn bad_input_gives_clear_errors_and_no_scene() {
         "{}",
         stderr(&r)
     );
+    // A bad --set is blamed on itself, not on the defaults it was applied to.
+    let r = lfgen(
+        &["--scenes", "1", "--out", o, "--set", "render.spp=many"],
+        &[],
+    );
+    assert!(
+        stderr(&r).contains("--set render.spp=many"),
+        "{}",
+        stderr(&r)
+    );
+    // Every cause once: the OS error is not repeated by the error chain.
+    let r = lfgen(&["preview", d.path().join("none").to_str().unwrap()], &[]);
+    let err = stderr(&r);
+    assert!(
+        !r.status.success() && err.matches("os error 2").count() == 1,
+        "{err}"
+    );
 }
 
 #[test]

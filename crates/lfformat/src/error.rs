@@ -62,11 +62,22 @@ impl fmt::Display for Error {
     }
 }
 
-impl std::error::Error for Error {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            Self::Io { source, .. } => Some(source),
-            Self::Format { .. } => None,
-        }
+/// No `source()`: the message already ends with the operating system's words, and a chain
+/// printer (`anyhow`'s `{:#}`) would repeat them ("…: No such file or directory (os error 2):
+/// No such file or directory (os error 2)").
+impl std::error::Error for Error {}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_io_error_names_the_file_and_the_cause_once() {
+        let e = Error::io(
+            Path::new("/x/manifest.json"),
+            std::io::Error::from(std::io::ErrorKind::NotFound),
+        );
+        assert_eq!(e.to_string(), "/x/manifest.json: entity not found");
+        assert!(std::error::Error::source(&e).is_none());
     }
 }

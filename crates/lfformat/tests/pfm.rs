@@ -118,7 +118,11 @@ fn missing_file_is_an_io_error_naming_it() {
     match read_pfm(path) {
         Err(e @ Error::Io { .. }) => {
             assert_eq!(e.path(), path);
-            assert!(std::error::Error::source(&e).is_some());
+            let Error::Io { source, .. } = &e else {
+                unreachable!()
+            };
+            assert_eq!(source.kind(), std::io::ErrorKind::NotFound);
+            assert!(e.to_string().ends_with(&source.to_string()), "{e}");
         }
         other => panic!("expected an I/O error, got {other:?}"),
     }
