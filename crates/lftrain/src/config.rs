@@ -56,6 +56,15 @@ pub struct NetConfig {
     pub head_blocks: usize,
 }
 
+impl NetConfig {
+    /// Pixels on each side of an output pixel that reach it: every block's two 2×2
+    /// convolutions widen the field by one pixel per side, over the stream blocks, the head
+    /// blocks and the final block (the thesis net: 3 + 7 + 1 = 11, a 23 px field).
+    pub fn receptive_radius(&self) -> usize {
+        self.stream_blocks + self.head_blocks + 1
+    }
+}
+
 impl Default for NetConfig {
     fn default() -> Self {
         Self {
@@ -163,6 +172,23 @@ pub struct TrainConfig {
     /// BN parameters" with the learning-rate drop). Left out: never.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub freeze_bn_after: Option<usize>,
+    /// Linear learning-rate warm-up from 0 over this many steps (mmlf: 1 000; 0: none).
+    pub warmup_steps: usize,
+    /// Adam's ε (mmlf, PyTorch's default: 1e-8; burn's own default is 1e-5).
+    pub adam_epsilon: f64,
+    /// Crops are taken at least this many pixels inside the image (mmlf: 8), so no input
+    /// pixel near the crop edge is a clamped copy of the image border.
+    pub crop_margin: usize,
+    /// No loss within this many pixels of the crop edge, where zero padding reaches into the
+    /// receptive field (mmlf: its receptive radius, 11). Left out: the network's
+    /// [`NetConfig::receptive_radius`]; 0: every pixel.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub loss_border: Option<usize>,
+    /// No loss where the centre view is flat: the mean over a `texture_window²` window of
+    /// |neighbour − centre| (RGB mean) below this (mmlf: 0.02; 0: off).
+    pub texture_threshold: f32,
+    /// Side of that window (mmlf: 23, its receptive field).
+    pub texture_window: usize,
     /// Modes kept per pixel for multimodal targets (the thesis' loader: 12).
     pub max_modes: usize,
     /// Validate every this many steps (0: only at the end).
@@ -197,6 +223,12 @@ impl Default for TrainConfig {
             lr_decay_steps: Vec::new(),
             lr_decay: 0.1,
             freeze_bn_after: None,
+            warmup_steps: 1000,
+            adam_epsilon: 1e-8,
+            crop_margin: 8,
+            loss_border: None,
+            texture_threshold: 0.02,
+            texture_window: 23,
             max_modes: 12,
             val_every: 500,
             checkpoint_every: 500,
@@ -269,14 +301,44 @@ impl TrainConfig {
         if !(self.learning_rate > 0.0 && self.lr_decay > 0.0) {
             bail!("learning_rate and lr_decay must be positive");
         }
+        if !(self.adam_epsilon > 0.0 && self.adam_epsilon < 1.0) {
+            bail!("adam_epsilon must lie in (0, 1), got {}", self.adam_epsilon);
+        }
+        if 2 * self.loss_border() >= self.patch {
+            bail!(
+                "loss_border {} leaves nothing of a {} px patch to train on",
+                self.loss_border(),
+                self.patch
+            );
+        }
+        if !(0.0..1.0).contains(&self.texture_threshold) || self.texture_window.is_multiple_of(2) {
+            bail!("texture_threshold must lie in [0, 1) and texture_window be odd");
+        }
         Ok(())
     }
 
     /// The learning rate of the optimiser step that follows `done` finished steps (steps are
-    /// counted from 1: with `lr_decay_steps = [s]`, steps 1..=s use `learning_rate`).
+    /// counted from 1: with `lr_decay_steps = [s]`, steps 1..=s use `learning_rate`), ramped
+    /// up linearly over the first `warmup_steps` (step k of the warm-up uses k / warmup_steps
+    /// of it, as mmlf's schedule).
     pub fn learning_rate_after(&self, done: usize) -> f64 {
+        let ramp = match self.warmup_steps {
+            0 => 1.0,
+            w => ((done + 1) as f64 / w as f64).min(1.0),
+        };
+        self.decayed_rate_after(done) * ramp
+    }
+
+    /// The learning rate after the step decay alone (what the log reports when it changes).
+    pub fn decayed_rate_after(&self, done: usize) -> f64 {
         let drops = self.lr_decay_steps.iter().filter(|&&s| done >= s).count();
         self.learning_rate * self.lr_decay.powi(drops as i32)
+    }
+
+    /// Pixels at each crop edge that get no loss.
+    pub fn loss_border(&self) -> usize {
+        self.loss_border
+            .unwrap_or_else(|| self.net.receptive_radius())
     }
 
     /// Whether batch norm is frozen for the step that follows `done` finished steps.
@@ -295,12 +357,26 @@ mod tests {
     use super::*;
 
     #[test]
-    fn default_is_the_thesis_constant_rate_without_freezing() {
+    fn default_is_the_thesis_constant_rate_after_warm_up_without_freezing() {
         let cfg = TrainConfig::default();
-        for done in [0, 1, 5_000, 1_000_000] {
+        // Linear warm-up over 1 000 steps: step 1 at 1e-6, step 500 at 5e-4, step 1 000 on.
+        assert!((cfg.learning_rate_after(0) - 1e-6).abs() < 1e-15);
+        assert!((cfg.learning_rate_after(499) - 5e-4).abs() < 1e-15);
+        for done in [999, 1_000, 5_000, 1_000_000] {
             assert_eq!(cfg.learning_rate_after(done), 1e-3);
+        }
+        for done in [0, 1, 5_000, 1_000_000] {
             assert!(!cfg.bn_frozen_after(done));
         }
+        assert_eq!(cfg.adam_epsilon, 1e-8);
+        // The thesis net's receptive radius is mmlf's 11 px; the CPU recipe's 6 px.
+        assert_eq!(cfg.loss_border(), 11);
+        let small = NetConfig {
+            stream_blocks: 2,
+            head_blocks: 3,
+            ..NetConfig::default()
+        };
+        assert_eq!(small.receptive_radius(), 6);
         let text = toml::to_string_pretty(&cfg).unwrap();
         assert!(!text.contains("freeze_bn_after"));
         let back: TrainConfig = toml::from_str(&text).unwrap();
@@ -310,7 +386,7 @@ mod tests {
     #[test]
     fn step_decay_and_freezing_from_toml() {
         let cfg: TrainConfig = toml::from_str(
-            "learning_rate = 1e-3\nlr_decay_steps = [100, 300]\nlr_decay = 0.1\nfreeze_bn_after = 100\n",
+            "learning_rate = 1e-3\nlr_decay_steps = [100, 300]\nlr_decay = 0.1\nfreeze_bn_after = 100\nwarmup_steps = 0\n",
         )
         .unwrap();
         cfg.validate().unwrap();
@@ -326,6 +402,17 @@ mod tests {
         assert_eq!(back, cfg);
         let bad: TrainConfig = toml::from_str("lr_decay = 0.0").unwrap();
         assert!(bad.validate().is_err());
+    }
+
+    #[test]
+    fn the_shipped_cpu_recipe_parses_and_keeps_its_measured_settings() {
+        let cfg: TrainConfig = toml::from_str(include_str!("../configs/cpu_small.toml")).unwrap();
+        cfg.validate().unwrap();
+        assert_eq!(
+            (cfg.warmup_steps, cfg.loss_border(), cfg.crop_margin),
+            (0, 0, 0)
+        );
+        assert_eq!(cfg.texture_threshold, 0.0);
     }
 
     #[test]

@@ -18,6 +18,7 @@ pub mod lightfield;
 pub mod loader;
 pub mod log;
 pub mod loss;
+pub mod mask;
 pub mod model;
 pub mod predict;
 pub mod run;

@@ -102,7 +102,7 @@ fn run(
     let load = |d: &SceneDir| {
         let scene = Scene::load(&d.path, &d.name, cfg.target_modes())?;
         fits_patch(&scene, cfg.patch)?;
-        Ok(scene)
+        Ok(scene.with_texture_mask(cfg.texture_window, cfg.texture_threshold))
     };
     let initial: Vec<&SceneDir> = dirs.iter().take(pool_cfg.scenes.max(1)).collect();
     let mut pool = match initial
@@ -135,8 +135,8 @@ fn run(
                 let mut r = Pcg32::new(seed, stream);
                 let scene = &pool[r.random_range(0..pool.len())];
                 let size = (scene.lf.width, scene.lf.height);
-                let draw = Draw::random(&cfg.augment, cfg.patch, size, &mut r);
-                make_sample(scene, &draw, cfg.patch)
+                let draw = Draw::random(&cfg.augment, cfg.patch, cfg.crop_margin, size, &mut r);
+                make_sample(scene, &draw, cfg.patch, cfg.loss_border())
             })
             .collect();
         let batch = Batch::from_samples(samples, cfg.patch, cfg.target_modes());

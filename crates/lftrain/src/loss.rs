@@ -1,7 +1,8 @@
 //! The training losses of thesis §5.2.1 on network outputs `[B, C, H, W]` and targets
 //! `[B, L, H, W]` (disparity `d_j` and weight `η_j` per slot; the unimodal case is `L = 1` with
 //! the front-most mode and `η = 1`, so one formula serves both). Every loss is the sum over
-//! pixels and modes of `η_j ℓ(d_j)`, divided by the number of pixels `N` (eq. 5.4–5.16).
+//! pixels and modes of `η_j ℓ(d_j)`, divided by the number of pixels `N` (eq. 5.4–5.16) inside
+//! the loss region (η is 0 outside it, see [`crate::mask`]).
 
 use burn::prelude::*;
 use burn::tensor::activation::log_softmax;
@@ -16,6 +17,8 @@ pub struct TargetTensors {
     pub eta: Tensor<4>,
     /// `[B, L, H, W]` DPP bin of each disparity (DPP only).
     pub bins: Option<Tensor<4, Int>>,
+    /// `N`: the pixels inside the loss region (η is 0 outside it).
+    pub pixels: f32,
 }
 
 /// The DPP bin of disparity `d`: equal bins over `[min, max]`, the outer ones open-ended
@@ -43,16 +46,10 @@ fn channel(out: &Tensor<4>, c: usize, like: &Tensor<4>) -> Tensor<4> {
     out.clone().narrow(1, c, 1).expand(like.shape())
 }
 
-/// Number of pixels `B·H·W`.
-fn pixels(t: &Tensor<4>) -> f32 {
-    let [b, _, h, w] = t.shape().dims();
-    (b * h * w) as f32
-}
-
 /// BASE: `Σ_j η_j |d_j − f|` (eq. 5.4, 5.8).
 fn l1(out: Tensor<4>, t: &TargetTensors) -> Tensor<1> {
     let f = channel(&out, 0, &t.disparity);
-    let n = pixels(&t.disparity);
+    let n = t.pixels.max(1.0);
     (t.eta.clone() * (t.disparity.clone() - f).abs()).sum() / n
 }
 
@@ -60,7 +57,7 @@ fn l1(out: Tensor<4>, t: &TargetTensors) -> Tensor<1> {
 fn laplace_nll(out: Tensor<4>, t: &TargetTensors, weights: Tensor<4>) -> Tensor<1> {
     let mu = channel(&out, 0, &t.disparity);
     let log_b = channel(&out, 1, &t.disparity);
-    let n = pixels(&t.disparity);
+    let n = t.pixels.max(1.0);
     let nll = (t.disparity.clone() - mu).abs() * log_b.clone().neg().exp() + log_b;
     (weights * nll).sum() / n
 }
@@ -69,6 +66,6 @@ fn laplace_nll(out: Tensor<4>, t: &TargetTensors, weights: Tensor<4>) -> Tensor<
 fn cross_entropy(out: Tensor<4>, t: &TargetTensors) -> Tensor<1> {
     let bins = t.bins.clone().expect("DPP targets carry bin indices");
     let log_q = log_softmax(out, 1).gather(1, bins);
-    let n = pixels(&t.disparity);
+    let n = t.pixels.max(1.0);
     (t.eta.clone() * log_q).sum().neg() / n
 }

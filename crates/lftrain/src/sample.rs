@@ -6,6 +6,7 @@ use rand::{Rng, RngExt};
 use crate::augment::Photometric;
 use crate::config::AugmentConfig;
 use crate::lightfield::{crop_plane, rotate_plane};
+use crate::mask::inside_border;
 use crate::scene::{Scene, Targets};
 use crate::stacks::{Direction, Region, extract};
 
@@ -23,14 +24,20 @@ pub struct Draw {
 }
 
 impl Draw {
-    /// A random draw for a `patch`-sized crop of a `width × height` scene.
+    /// A random draw for a `patch`-sized crop of a `width × height` scene, at least `margin`
+    /// pixels inside it where the scene is large enough (else as far inside as it allows).
     pub fn random(
         cfg: &AugmentConfig,
         patch: usize,
+        margin: usize,
         (width, height): (usize, usize),
         rng: &mut impl Rng,
     ) -> Self {
-        let mut origin = |size: usize| rng.random_range(0..=size.saturating_sub(patch));
+        let mut origin = |size: usize| {
+            let room = size.saturating_sub(patch);
+            let lo = margin.min(room / 2);
+            rng.random_range(lo..=room - lo)
+        };
         let origin = (origin(width), origin(height));
         let shift = if cfg.max_shift > 0.0 {
             rng.random_range(-cfg.max_shift..=cfg.max_shift)
@@ -58,16 +65,20 @@ pub struct Sample {
     pub stacks: [Vec<f32>; 4],
     /// Target disparities (after the shift).
     pub disparity: Vec<f32>,
-    /// Target weights.
+    /// Target weights, 0 outside the loss region.
     pub eta: Vec<f32>,
+    /// Pixels inside the loss region (the losses' `N`).
+    pub loss_pixels: usize,
 }
 
 /// The sample of `scene` for `draw`.
 ///
 /// The crop is taken with a margin wide enough for the EPI shift of the outer views, so the
 /// shifted stacks read real pixels wherever the scene has them, then rotated (views, view grid
-/// and targets together), then the stacks are extracted with the shift.
-pub fn make_sample(scene: &Scene, draw: &Draw, patch: usize) -> Sample {
+/// and targets together), then the stacks are extracted with the shift. The loss region leaves
+/// out `border` pixels at each crop edge and the scene's flat pixels ([`Scene::texture`],
+/// cropped and rotated with the views).
+pub fn make_sample(scene: &Scene, draw: &Draw, patch: usize, border: usize) -> Sample {
     let c = scene.lf.centre() as f32;
     let margin = (c * draw.shift.abs()).ceil() as usize + 1;
     let (x0, y0) = (draw.origin.0 as isize, draw.origin.1 as isize);
@@ -87,12 +98,38 @@ pub fn make_sample(scene: &Scene, draw: &Draw, patch: usize) -> Sample {
         draw.photometric.apply(&mut s, patch * patch);
         s
     });
-    let (disparity, eta) = target_planes(&scene.targets, (x0, y0), patch, draw);
+    let (disparity, mut eta) = target_planes(&scene.targets, (x0, y0), patch, draw);
+    let region = loss_region(scene, (x0, y0), patch, draw.turns, border);
+    for slot in eta.chunks_exact_mut(patch * patch) {
+        slot.iter_mut().zip(&region).for_each(|(e, r)| *e *= r);
+    }
     Sample {
         stacks,
         disparity,
         eta,
+        loss_pixels: region.iter().filter(|&&r| r > 0.0).count(),
     }
+}
+
+/// 1 where the crop's pixels get a loss, 0 elsewhere (`patch²`, in the rotated frame).
+fn loss_region(
+    scene: &Scene,
+    origin: (isize, isize),
+    patch: usize,
+    turns: usize,
+    border: usize,
+) -> Vec<f32> {
+    let (w, h) = (scene.lf.width, scene.lf.height);
+    let mut texture = crop_plane(&scene.texture, w, h, 1, origin, (patch, patch));
+    for _ in 0..turns % 4 {
+        texture = rotate_plane(&texture, patch, patch, 1);
+    }
+    for (i, t) in texture.iter_mut().enumerate() {
+        if !inside_border(i % patch, i / patch, patch, border) {
+            *t = 0.0;
+        }
+    }
+    texture
 }
 
 /// The targets of the crop, rotated, shifted by `-shift` and split into planes.
@@ -139,6 +176,8 @@ pub struct Batch {
     pub disparity: Vec<f32>,
     /// Target weights.
     pub eta: Vec<f32>,
+    /// Pixels inside the loss region, over all samples.
+    pub loss_pixels: usize,
 }
 
 impl Batch {
@@ -148,6 +187,7 @@ impl Batch {
         let stack_channels = samples[0].stacks[0].len() / (patch * patch);
         let mut stacks: [Vec<f32>; 4] = Default::default();
         let (mut disparity, mut eta) = (Vec::new(), Vec::new());
+        let loss_pixels = samples.iter().map(|s| s.loss_pixels).sum();
         for s in samples {
             for (all, one) in stacks.iter_mut().zip(s.stacks) {
                 all.extend(one);
@@ -163,6 +203,7 @@ impl Batch {
             stacks,
             disparity,
             eta,
+            loss_pixels,
         }
     }
 }

@@ -6,6 +6,7 @@ use anyhow::{Result, bail};
 use lfeval::truth::{EtaKind, SceneTruth, eta_of, front};
 
 use crate::lightfield::LightField;
+use crate::mask::texture_mask;
 
 /// Per-pixel disparity targets: `modes` pairs `(d_j, η_j)` per pixel, interleaved
 /// (`(pixel * modes + j) * 2`), row-major, top row first. Unused slots are `(0, 0)` so that
@@ -63,6 +64,9 @@ pub struct Scene {
     pub lf: LightField,
     /// Disparity targets of the centre view.
     pub targets: Targets,
+    /// 1 where the centre view is textured enough for a loss, 0 where flat (row-major);
+    /// all 1 until [`Scene::with_texture_mask`].
+    pub texture: Vec<f32>,
 }
 
 impl Scene {
@@ -83,9 +87,18 @@ impl Scene {
         Ok(Self {
             name: name.to_string(),
             dir: dir.to_path_buf(),
-            lf,
             targets: Targets::from_truth(&truth, modes),
+            texture: vec![1.0; lf.width * lf.height],
+            lf,
         })
+    }
+
+    /// The scene with its flat pixels masked ([`texture_mask`] of the centre view).
+    pub fn with_texture_mask(self, window: usize, threshold: f32) -> Self {
+        let c = self.lf.centre();
+        let (w, h) = (self.lf.width, self.lf.height);
+        let texture = texture_mask(self.lf.view(c, c), w, h, window, threshold);
+        Self { texture, ..self }
     }
 }
 

@@ -36,6 +36,7 @@ pub fn target_tensors(batch: &Batch, cfg: &TrainConfig, device: &Device) -> Targ
         disparity: tensor4(batch.disparity.clone(), shape, device),
         eta: tensor4(batch.eta.clone(), shape, device),
         bins,
+        pixels: batch.loss_pixels as f32,
     }
 }
 

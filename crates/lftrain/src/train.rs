@@ -93,9 +93,9 @@ pub fn train(mut cfg: TrainConfig, args: &TrainArgs) -> Result<TrainSummary> {
     base.seed(cfg.seed);
     let (net, optim) = if args.resume {
         let net = run.load_net(&cfg, grid, &device)?;
-        (net, run.load_optimizer(AdamConfig::new().init())?)
+        (net, run.load_optimizer(adam(&cfg))?)
     } else {
-        (build_net(&cfg, grid, &device), AdamConfig::new().init())
+        (build_net(&cfg, grid, &device), adam(&cfg))
     };
     let loader = Loader::start(train_scenes, cfg.clone(), args.pool, state.step as u64)?;
     let mut log = TrainLog::open(&args.out, args.resume, state.step)?;
@@ -138,8 +138,8 @@ impl Trainer {
         let (first, mut last_val) = (self.state.step, None);
         while self.state.step < self.cfg.steps {
             let done = self.state.step;
-            let lr = self.cfg.learning_rate_after(done);
-            if done > 0 && lr != self.cfg.learning_rate_after(done - 1) {
+            let lr = self.cfg.decayed_rate_after(done);
+            if done > 0 && lr != self.cfg.decayed_rate_after(done - 1) {
                 bar.println(format!("step {}: learning rate {lr:e}", done + 1));
             }
             // Also on the first step after --resume past the freeze: the checkpoint holds the
@@ -214,6 +214,13 @@ impl Trainer {
     }
 }
 
+/// Adam with `cfg`'s ε.
+fn adam(cfg: &TrainConfig) -> ModuleOptimizer {
+    AdamConfig::new()
+        .with_epsilon(cfg.adam_epsilon as f32)
+        .init()
+}
+
 /// Whether `step` is a multiple of a non-zero `period`.
 fn every(step: usize, period: usize) -> bool {
     period > 0 && step.is_multiple_of(period)
@@ -260,11 +267,12 @@ pub fn bench_steps(cfg: &TrainConfig, grid: usize, steps: usize) -> Result<(f64,
         stacks: std::array::from_fn(|_| noise(plane * grid * 3, 1.0)),
         disparity: noise(plane * modes, 6.0),
         eta: vec![1.0 / modes as f32; plane * modes],
+        loss_pixels: plane,
     };
     let mut trainer = Trainer {
         cfg: cfg.clone(),
         net: build_net(cfg, grid, &device),
-        optim: AdamConfig::new().init(),
+        optim: adam(cfg),
         device,
         base,
         state: RunState::default(),

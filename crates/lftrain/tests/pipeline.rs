@@ -65,8 +65,8 @@ fn rotated_samples_match_samples_of_the_rendered_rotation() {
             photometric: Photometric::IDENTITY,
         };
         // The whole image as the crop: rotating it is rotating the scene.
-        let a = make_sample(&original, &draw(turns), 20);
-        let b = make_sample(&load(turns), &draw(0), 20);
+        let a = make_sample(&original, &draw(turns), 20, 0);
+        let b = make_sample(&load(turns), &draw(0), 20, 0);
         for k in 0..4 {
             // 8-bit views: the rotated scene's PNG rounds the same colours.
             let diff = max_diff(&a.stacks[k], &b.stacks[k]);
@@ -74,6 +74,19 @@ fn rotated_samples_match_samples_of_the_rendered_rotation() {
         }
         assert_eq!(a.disparity, b.disparity, "{turns} turns: targets");
         assert_eq!(a.eta, b.eta);
+        // The loss region turns with the views: the texture mask of the rotated crop is the
+        // mask of the rotated scene (mmlf forgets this), and the border is the same square.
+        let masked = |s: Scene| s.with_texture_mask(5, 0.12);
+        let a = make_sample(&masked(load(0)), &draw(turns), 20, 3);
+        let b = make_sample(&masked(load(turns)), &draw(0), 20, 3);
+        assert_eq!(a.eta, b.eta, "{turns} turns: loss region");
+        assert_eq!(a.loss_pixels, b.loss_pixels);
+        let inner = 14 * 14;
+        assert!(
+            a.loss_pixels > 0 && a.loss_pixels < inner,
+            "{turns} turns: {} of {inner} inner pixels textured (the test needs both kinds)",
+            a.loss_pixels
+        );
     }
 }
 
@@ -116,9 +129,17 @@ fn shifting_by_the_disparity_aligns_the_views_and_zeroes_the_target() {
         shift: d,
         photometric: Photometric::IDENTITY,
     };
-    let sample = make_sample(&scene, &draw, 16);
+    let sample = make_sample(&scene, &draw, 16, 0);
     assert!(sample.disparity.iter().all(|t| t.abs() < 1e-6));
     assert!(sample.eta.iter().all(|&e| e == 1.0));
+    assert_eq!(sample.loss_pixels, 256);
+    // A 4 px loss border keeps the inner 8 × 8 pixels, and only them.
+    let sample = make_sample(&scene, &draw, 16, 4);
+    assert_eq!(sample.loss_pixels, 64);
+    for (i, &e) in sample.eta.iter().enumerate() {
+        let inner = (4..12).contains(&(i % 16)) && (4..12).contains(&(i / 16));
+        assert_eq!(e, if inner { 1.0 } else { 0.0 }, "pixel {i}");
+    }
 }
 
 #[test]
@@ -137,8 +158,9 @@ fn random_draws_stay_in_range() {
     let cfg = AugmentConfig::default();
     let mut rng = rand_pcg::Pcg32::new(1, 2);
     for _ in 0..200 {
-        let d = Draw::random(&cfg, 16, (40, 24), &mut rng);
-        assert!(d.origin.0 <= 24 && d.origin.1 <= 8 && d.turns < 4);
+        // 8 px inside along x (room 24); along y the room (8) allows 4 on each side.
+        let d = Draw::random(&cfg, 16, 8, (40, 24), &mut rng);
+        assert!((8..=16).contains(&d.origin.0) && d.origin.1 == 4 && d.turns < 4);
         assert!(d.shift.abs() <= 2.0);
     }
 }

@@ -22,6 +22,7 @@ fn targets(dev: &Device) -> TargetTensors {
         disparity: tensor4(vec![1.0, 2.0, 0.0, 0.0], [1, 2, 1, 2], dev),
         eta: tensor4(vec![0.25, 1.0, 0.75, 0.0], [1, 2, 1, 2], dev),
         bins: None,
+        pixels: 2.0,
     }
 }
 
@@ -71,6 +72,7 @@ fn dpp_cross_entropy_against_eta_weighted_bins() {
             TensorData::new(vec![0i64, 1], [1, 2, 1, 1]),
             &dev,
         )),
+        pixels: 1.0,
     };
     let ce = scalar(loss(&c, logits, &t));
     let want = -(0.25 * 0.25f32.ln() + 0.75 * 0.75f32.ln());
@@ -120,6 +122,7 @@ fn gradient_matches_finite_differences() {
         ),
         eta: tensor4(vec![1.0; 72], [2, 1, 6, 6], &dev),
         bins: None,
+        pixels: 72.0,
     };
     let eval = |x: &[f32]| -> Tensor<1> {
         let stacks = std::array::from_fn(|_| tensor4(x.to_vec(), shape, &dev));
@@ -219,6 +222,11 @@ fn tiny_model_overfits_tiny_dataset_then_predicts_for_lfeval() {
             head_width: 16,
             head_blocks: 2,
         },
+        // Capacity, not the recipe: every pixel of the whole 24² scene trained at full rate
+        // (validation scores all of it).
+        warmup_steps: 0,
+        loss_border: Some(0),
+        texture_threshold: 0.0,
         ..TrainConfig::default()
     };
     cfg.augment.max_shift = 0.0;
