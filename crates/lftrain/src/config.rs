@@ -42,6 +42,20 @@ impl ModelKind {
     }
 }
 
+/// Which mode a unimodal target takes where a pixel has several.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum UnimodalTarget {
+    /// The front-most mode whose η reaches `target_min_eta` — the closest surface the pixel
+    /// visibly shows; the dominant mode where none does. A 1e-4 sliver of a thin foreground
+    /// edge does not make the target jump to it.
+    Visible,
+    /// The front-most mode with any η > 0 (the literal reading; lftrain's earlier target).
+    Front,
+    /// The mode with the largest η (mmlf's `--train_loss_strongest`).
+    Dominant,
+}
+
 /// Widths and depths of the EPINET-style network; defaults are appendix B.1 (Tables B.2, B.3).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -189,6 +203,10 @@ pub struct TrainConfig {
     pub texture_threshold: f32,
     /// Side of that window (mmlf: 23, its receptive field).
     pub texture_window: usize,
+    /// The mode a unimodal target takes (`multimodal = false`).
+    pub target: UnimodalTarget,
+    /// The η a mode needs to count as visible for `target = "visible"`.
+    pub target_min_eta: f32,
     /// Modes kept per pixel for multimodal targets (the thesis' loader: 12).
     pub max_modes: usize,
     /// Validate every this many steps (0: only at the end).
@@ -229,6 +247,8 @@ impl Default for TrainConfig {
             loss_border: None,
             texture_threshold: 0.02,
             texture_window: 23,
+            target: UnimodalTarget::Visible,
+            target_min_eta: 0.1,
             max_modes: 12,
             val_every: 500,
             checkpoint_every: 500,
@@ -309,6 +329,12 @@ impl TrainConfig {
                 "loss_border {} leaves nothing of a {} px patch to train on",
                 self.loss_border(),
                 self.patch
+            );
+        }
+        if !(self.target_min_eta > 0.0 && self.target_min_eta <= 1.0) {
+            bail!(
+                "target_min_eta must lie in (0, 1], got {}",
+                self.target_min_eta
             );
         }
         if !(0.0..1.0).contains(&self.texture_threshold) || self.texture_window.is_multiple_of(2) {
@@ -413,6 +439,7 @@ mod tests {
             (0, 0, 0)
         );
         assert_eq!(cfg.texture_threshold, 0.0);
+        assert_eq!(cfg.target, UnimodalTarget::Front);
     }
 
     #[test]

@@ -17,7 +17,7 @@ use rayon::prelude::*;
 
 use crate::config::TrainConfig;
 use crate::sample::{Batch, Draw, make_sample};
-use crate::scene::Scene;
+use crate::scene::{Scene, Unimodal};
 
 /// Pool and refresh sizes of the loader.
 #[derive(Clone, Copy, Debug)]
@@ -100,7 +100,7 @@ fn run(
 ) {
     let mut rng = Pcg32::new(cfg.seed, stream);
     let load = |d: &SceneDir| {
-        let scene = Scene::load(&d.path, &d.name, cfg.target_modes())?;
+        let scene = Scene::load(&d.path, &d.name, cfg.target_modes(), Unimodal::of(&cfg))?;
         fits_patch(&scene, cfg.patch)?;
         Ok(scene.with_texture_mask(cfg.texture_window, cfg.texture_threshold))
     };

@@ -3,7 +3,10 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
-use lfeval::truth::{EtaKind, SceneTruth, eta_of, front};
+use lfeval::truth::{EtaKind, SceneTruth, dominant, eta_of, front};
+use lfformat::Mode;
+
+use crate::config::{TrainConfig, UnimodalTarget};
 
 use crate::lightfield::LightField;
 use crate::mask::texture_mask;
@@ -24,14 +27,14 @@ pub struct Targets {
 }
 
 impl Targets {
-    /// Targets of `truth`: the front-most mode with `η = 1` when `modes == 1` (the thesis'
-    /// unimodal truth), else the first `modes` modes front to back with their `η`.
-    pub fn from_truth(truth: &SceneTruth, modes: usize) -> Self {
+    /// Targets of `truth`: the mode `unimodal` picks with `η = 1` when `modes == 1` (the
+    /// thesis' unimodal truth), else the first `modes` modes front to back with their `η`.
+    pub fn from_truth(truth: &SceneTruth, modes: usize, unimodal: Unimodal) -> Self {
         let mut pairs = Vec::with_capacity(truth.width() * truth.height() * modes * 2);
         for pixel in truth.modes.pixels() {
             let mut slots = vec![0.0f32; modes * 2];
             if modes == 1 {
-                if let Some(d) = front(pixel, EtaKind::Over).filter(|d| d.is_finite()) {
+                if let Some(d) = unimodal.pick(pixel).filter(|d| d.is_finite()) {
                     slots = vec![d, 1.0];
                 }
             } else {
@@ -49,6 +52,36 @@ impl Targets {
             height: truth.height(),
             modes,
             pairs,
+        }
+    }
+}
+
+/// How a unimodal target is chosen: [`UnimodalTarget`] with its visibility threshold.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Unimodal {
+    pub target: UnimodalTarget,
+    pub min_eta: f32,
+}
+
+impl Unimodal {
+    /// The target of `cfg`.
+    pub fn of(cfg: &TrainConfig) -> Self {
+        Self {
+            target: cfg.target,
+            min_eta: cfg.target_min_eta,
+        }
+    }
+
+    /// The chosen disparity of a pixel's modes (front to back), if it has any.
+    pub fn pick(self, modes: &[Mode]) -> Option<f32> {
+        match self.target {
+            UnimodalTarget::Front => front(modes, EtaKind::Over),
+            UnimodalTarget::Dominant => dominant(modes, EtaKind::Over),
+            UnimodalTarget::Visible => modes
+                .iter()
+                .find(|m| eta_of(m, EtaKind::Over) >= self.min_eta && m.disparity.is_finite())
+                .map(|m| m.disparity)
+                .or_else(|| dominant(modes, EtaKind::Over)),
         }
     }
 }
@@ -71,7 +104,7 @@ pub struct Scene {
 
 impl Scene {
     /// Loads views and ground truth (`modes.exr` if present, else `gt_disp_lowres.pfm`).
-    pub fn load(dir: &Path, name: &str, modes: usize) -> Result<Self> {
+    pub fn load(dir: &Path, name: &str, modes: usize, unimodal: Unimodal) -> Result<Self> {
         let lf = LightField::load(dir)?;
         let truth = SceneTruth::load(dir)?;
         if (truth.width(), truth.height()) != (lf.width, lf.height) {
@@ -87,7 +120,7 @@ impl Scene {
         Ok(Self {
             name: name.to_string(),
             dir: dir.to_path_buf(),
-            targets: Targets::from_truth(&truth, modes),
+            targets: Targets::from_truth(&truth, modes, unimodal),
             texture: vec![1.0; lf.width * lf.height],
             lf,
         })
@@ -126,12 +159,39 @@ mod tests {
             hci: FloatImage::new(2, 1, vec![1.5, f32::NAN]),
             modes,
         };
-        let uni = Targets::from_truth(&truth, 1);
+        let front = Unimodal {
+            target: UnimodalTarget::Front,
+            min_eta: 0.1,
+        };
+        let uni = Targets::from_truth(&truth, 1, front);
         assert_eq!(uni.pairs, vec![1.5, 1.0, 0.0, 0.0]);
-        let multi = Targets::from_truth(&truth, 3);
+        let multi = Targets::from_truth(&truth, 3, front);
         assert_eq!(
             multi.pairs,
             vec![1.5, 0.4, -1.0, 0.6, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
         );
+    }
+
+    #[test]
+    fn the_visible_target_skips_slivers_and_falls_back_to_the_dominant_mode() {
+        let pick = |target, modes: &[Mode]| {
+            Unimodal {
+                target,
+                min_eta: 0.1,
+            }
+            .pick(modes)
+        };
+        // A 1e-4 sliver in front of a wall: "front" takes the sliver, "visible" the wall.
+        let sliver = [mode(3.0, 1e-4), mode(0.5, 0.9999)];
+        assert_eq!(pick(UnimodalTarget::Front, &sliver), Some(3.0));
+        assert_eq!(pick(UnimodalTarget::Visible, &sliver), Some(0.5));
+        // A visible foreground (η 0.3) stays the target although the back has more η.
+        let veil = [mode(2.0, 0.3), mode(-1.0, 0.7)];
+        assert_eq!(pick(UnimodalTarget::Visible, &veil), Some(2.0));
+        assert_eq!(pick(UnimodalTarget::Dominant, &veil), Some(-1.0));
+        // No mode reaches 0.1: the dominant one.
+        let faint = [mode(1.0, 0.04), mode(0.0, 0.06)];
+        assert_eq!(pick(UnimodalTarget::Visible, &faint), Some(0.0));
+        assert_eq!(pick(UnimodalTarget::Visible, &[]), None);
     }
 }

@@ -9,6 +9,10 @@ use lftrain::scene::Scene;
 use lftrain::stacks::{Direction, Region, extract};
 use lftrain::synthetic::TwoPlanes;
 
+fn uni() -> lftrain::scene::Unimodal {
+    lftrain::scene::Unimodal::of(&lftrain::config::TrainConfig::default())
+}
+
 fn max_diff(a: &[f32], b: &[f32]) -> f32 {
     assert_eq!(a.len(), b.len());
     a.iter()
@@ -55,7 +59,7 @@ fn rotated_samples_match_samples_of_the_rendered_rotation() {
             .write(&dir.path().join(format!("t{turns}")), true)
             .unwrap();
     }
-    let load = |t: usize| Scene::load(&dir.path().join(format!("t{t}")), "s", 3).unwrap();
+    let load = |t: usize| Scene::load(&dir.path().join(format!("t{t}")), "s", 3, uni()).unwrap();
     let original = load(0);
     for turns in 1..4 {
         let draw = |turns| Draw {
@@ -122,7 +126,7 @@ fn shifting_by_the_disparity_aligns_the_views_and_zeroes_the_target() {
     }
     let dir = tempfile::tempdir().unwrap();
     plane.write(dir.path(), false).unwrap();
-    let scene = Scene::load(dir.path(), "plane", 1).unwrap();
+    let scene = Scene::load(dir.path(), "plane", 1, uni()).unwrap();
     let draw = Draw {
         origin: (4, 4),
         turns: 0,
