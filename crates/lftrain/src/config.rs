@@ -98,12 +98,30 @@ pub struct AugmentConfig {
     pub max_shift: f32,
     /// Random rotation by multiples of 90° (square view grids only).
     pub rotate: bool,
-    /// Random rotation of the colours about the grey axis of RGB space.
-    pub colour_rotation: bool,
-    /// Brightness offset drawn from `[-brightness, brightness]`.
+    /// How colours are mixed (one random 3×3 matrix per sample).
+    pub colour: ColourAugment,
+    /// Brightness factor drawn from this range (mmlf: ×U[0.1, 1.9]; [1, 1]: off).
+    pub brightness_scale: [f32; 2],
+    /// Contrast factor about the sample's mean grey, drawn from this range (mmlf: U[0.1, 1.9]).
+    pub contrast_scale: [f32; 2],
+    /// lftrain's earlier, milder augmentation: a brightness offset in `[-brightness,
+    /// brightness]` (0: off) ...
     pub brightness: f32,
-    /// Contrast factor drawn from `[1 - contrast, 1 + contrast]`.
+    /// ... and a contrast factor in `[1 - contrast, 1 + contrast]` about mid-grey (0: off).
     pub contrast: f32,
+}
+
+/// The random colour matrix of a sample.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ColourAugment {
+    /// A random mix whose rows and columns sum to 1 (mmlf's `RedistColor`): a random convex
+    /// combination of the six channel permutations.
+    Redistribute,
+    /// A rotation about the grey axis (keeps grey levels; lftrain's earlier augmentation).
+    Rotate,
+    /// None.
+    Off,
 }
 
 impl Default for AugmentConfig {
@@ -111,9 +129,11 @@ impl Default for AugmentConfig {
         Self {
             max_shift: 2.0,
             rotate: true,
-            colour_rotation: true,
-            brightness: 0.1,
-            contrast: 0.2,
+            colour: ColourAugment::Redistribute,
+            brightness_scale: [0.1, 1.9],
+            contrast_scale: [0.1, 1.9],
+            brightness: 0.0,
+            contrast: 0.0,
         }
     }
 }
@@ -335,6 +355,15 @@ impl TrainConfig {
             bail!(
                 "target_min_eta must lie in (0, 1], got {}",
                 self.target_min_eta
+            );
+        }
+        let a = &self.augment;
+        if [a.brightness_scale, a.contrast_scale]
+            .iter()
+            .any(|[lo, hi]| !(lo.is_finite() && hi.is_finite() && 0.0 <= *lo && lo <= hi))
+        {
+            bail!(
+                "augment.brightness_scale and contrast_scale must be [min, max] ranges of factors ≥ 0"
             );
         }
         if !(0.0..1.0).contains(&self.texture_threshold) || self.texture_window.is_multiple_of(2) {

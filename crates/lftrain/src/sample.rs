@@ -93,9 +93,19 @@ pub fn make_sample(scene: &Scene, draw: &Draw, patch: usize, border: usize) -> S
         width: patch,
         height: patch,
     };
+    let c = lf.centre();
+    let centre = crop_plane(
+        lf.view(c, c),
+        lf.width,
+        lf.height,
+        3,
+        (m, m),
+        (patch, patch),
+    );
+    let pivot = draw.photometric.pivot(&centre);
     let stacks = Direction::ALL.map(|dir| {
         let mut s = extract(&lf, dir, region, draw.shift);
-        draw.photometric.apply(&mut s, patch * patch);
+        draw.photometric.apply(&mut s, patch * patch, pivot);
         s
     });
     let (disparity, mut eta) = target_planes(&scene.targets, (x0, y0), patch, draw);

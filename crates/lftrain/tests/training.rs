@@ -231,8 +231,8 @@ fn tiny_model_overfits_tiny_dataset_then_predicts_for_lfeval() {
     };
     cfg.augment.max_shift = 0.0;
     cfg.augment.rotate = false;
-    cfg.augment.colour_rotation = false;
-    (cfg.augment.brightness, cfg.augment.contrast) = (0.0, 0.0);
+    cfg.augment.colour = lftrain::config::ColourAugment::Off;
+    (cfg.augment.brightness_scale, cfg.augment.contrast_scale) = ([1.0; 2], [1.0; 2]);
     let run = tmp.path().join("run");
     let args = TrainArgs {
         train: data.clone(),
