@@ -96,6 +96,9 @@ impl Default for NetConfig {
 pub struct AugmentConfig {
     /// Random EPI shift drawn uniformly from `[-max_shift, max_shift]` pixels (thesis: 2).
     pub max_shift: f32,
+    /// Random integer down-scaling by 1 ..= this factor, taking every k-th pixel (mmlf's
+    /// `RandomDownSampling(4)`); the disparities shrink by k. 1: off.
+    pub max_downscale: usize,
     /// Random rotation by multiples of 90° (square view grids only).
     pub rotate: bool,
     /// How colours are mixed (one random 3×3 matrix per sample).
@@ -128,6 +131,7 @@ impl Default for AugmentConfig {
     fn default() -> Self {
         Self {
             max_shift: 2.0,
+            max_downscale: 4,
             rotate: true,
             colour: ColourAugment::Redistribute,
             brightness_scale: [0.1, 1.9],
@@ -358,6 +362,12 @@ impl TrainConfig {
             );
         }
         let a = &self.augment;
+        if !(1..=16).contains(&a.max_downscale) {
+            bail!(
+                "augment.max_downscale must be 1 to 16, got {}",
+                a.max_downscale
+            );
+        }
         if [a.brightness_scale, a.contrast_scale]
             .iter()
             .any(|[lo, hi]| !(lo.is_finite() && hi.is_finite() && 0.0 <= *lo && lo <= hi))
@@ -469,6 +479,7 @@ mod tests {
         );
         assert_eq!(cfg.texture_threshold, 0.0);
         assert_eq!(cfg.target, UnimodalTarget::Front);
+        assert_eq!(cfg.augment.max_downscale, 1);
     }
 
     #[test]

@@ -96,14 +96,16 @@ impl LightField {
     }
 
     /// The `w × h` region at `(x0, y0)` (which may reach outside the image: edge pixels are
-    /// repeated, the thesis' nearest-neighbour padding).
-    pub fn crop(&self, x0: isize, y0: isize, w: usize, h: usize) -> Self {
+    /// repeated, the thesis' nearest-neighbour padding), taking every `step`-th pixel: a
+    /// down-scaling by `step` that divides every disparity by it.
+    pub fn crop(&self, (x0, y0): (isize, isize), (w, h): (usize, usize), step: usize) -> Self {
+        let (sw, sh) = (self.width, self.height);
         let views = self
             .views
             .iter()
             .map(|view| {
                 view.as_ref()
-                    .map(|rgb| crop_plane(rgb, self.width, self.height, 3, (x0, y0), (w, h)))
+                    .map(|rgb| crop_plane(rgb, sw, sh, 3, (x0, y0), (w, h), step))
             })
             .collect();
         Self {
@@ -167,8 +169,8 @@ pub fn rotate_plane<T: Copy>(data: &[T], w: usize, h: usize, channels: usize) ->
     out
 }
 
-/// The `size` region at `origin` of a `w × h` image with `channels` values per pixel,
-/// coordinates clamped to the image.
+/// The `size` region at `origin` of a `w × h` image with `channels` values per pixel, every
+/// `step`-th pixel (mmlf's down-scaling by slicing), coordinates clamped to the image.
 pub fn crop_plane<T: Copy>(
     data: &[T],
     w: usize,
@@ -176,12 +178,14 @@ pub fn crop_plane<T: Copy>(
     channels: usize,
     (x0, y0): (isize, isize),
     (cw, ch): (usize, usize),
+    step: usize,
 ) -> Vec<T> {
     let mut out = Vec::with_capacity(cw * ch * channels);
+    let step = step.max(1) as isize;
     for y in 0..ch as isize {
-        let sy = (y0 + y).clamp(0, h as isize - 1) as usize;
+        let sy = (y0 + y * step).clamp(0, h as isize - 1) as usize;
         for x in 0..cw as isize {
-            let sx = (x0 + x).clamp(0, w as isize - 1) as usize;
+            let sx = (x0 + x * step).clamp(0, w as isize - 1) as usize;
             let i = (sy * w + sx) * channels;
             out.extend_from_slice(&data[i..i + channels]);
         }
@@ -208,6 +212,16 @@ mod tests {
     #[test]
     fn crop_repeats_edge_pixels() {
         let img: Vec<u8> = (0..4).collect(); // 2 × 2
-        assert_eq!(crop_plane(&img, 2, 2, 1, (-1, 0), (3, 1)), vec![0, 0, 1]);
+        assert_eq!(crop_plane(&img, 2, 2, 1, (-1, 0), (3, 1), 1), vec![0, 0, 1]);
+        // Every second pixel of a 4 × 4 image, clamped at the edge (4 → 3).
+        let img: Vec<u8> = (0..16).collect();
+        assert_eq!(
+            crop_plane(&img, 4, 4, 1, (0, 0), (2, 2), 2),
+            vec![0, 2, 8, 10]
+        );
+        assert_eq!(
+            crop_plane(&img, 4, 4, 1, (2, 2), (2, 2), 2),
+            vec![10, 11, 14, 15]
+        );
     }
 }

@@ -15,6 +15,8 @@ use crate::stacks::{Direction, Region, extract};
 pub struct Draw {
     /// Crop origin (left, top) in the scene.
     pub origin: (usize, usize),
+    /// Down-scaling factor: the crop takes every `scale`-th pixel of `scale · patch` ones.
+    pub scale: usize,
     /// Quarter turns.
     pub turns: usize,
     /// EPI shift, pixels.
@@ -33,8 +35,14 @@ impl Draw {
         (width, height): (usize, usize),
         rng: &mut impl Rng,
     ) -> Self {
+        // The largest factor whose crop still fits the scene, then one of 1 ..= it.
+        let fits = (1..=cfg.max_downscale.max(1))
+            .rev()
+            .find(|k| k * patch <= width.min(height))
+            .unwrap_or(1);
+        let scale = rng.random_range(1..=fits);
         let mut origin = |size: usize| {
-            let room = size.saturating_sub(patch);
+            let room = size.saturating_sub(scale * patch);
             let lo = margin.min(room / 2);
             rng.random_range(lo..=room - lo)
         };
@@ -46,6 +54,7 @@ impl Draw {
         };
         Self {
             origin,
+            scale,
             turns: if cfg.rotate {
                 rng.random_range(0..4)
             } else {
@@ -82,10 +91,10 @@ pub fn make_sample(scene: &Scene, draw: &Draw, patch: usize, border: usize) -> S
     let c = scene.lf.centre() as f32;
     let margin = (c * draw.shift.abs()).ceil() as usize + 1;
     let (x0, y0) = (draw.origin.0 as isize, draw.origin.1 as isize);
-    let m = margin as isize;
-    let lf = scene
-        .lf
-        .crop(x0 - m, y0 - m, patch + 2 * margin, patch + 2 * margin)
+    let (m, k) = (margin as isize, draw.scale.max(1));
+    let side = patch + 2 * margin;
+    let lf = (scene.lf)
+        .crop((x0 - m * k as isize, y0 - m * k as isize), (side, side), k)
         .rotate(draw.turns);
     let region = Region {
         x0: margin,
@@ -101,6 +110,7 @@ pub fn make_sample(scene: &Scene, draw: &Draw, patch: usize, border: usize) -> S
         3,
         (m, m),
         (patch, patch),
+        1,
     );
     let pivot = draw.photometric.pivot(&centre);
     let stacks = Direction::ALL.map(|dir| {
@@ -109,7 +119,7 @@ pub fn make_sample(scene: &Scene, draw: &Draw, patch: usize, border: usize) -> S
         s
     });
     let (disparity, mut eta) = target_planes(&scene.targets, (x0, y0), patch, draw);
-    let region = loss_region(scene, (x0, y0), patch, draw.turns, border);
+    let region = loss_region(scene, (x0, y0), patch, draw, border);
     for slot in eta.chunks_exact_mut(patch * patch) {
         slot.iter_mut().zip(&region).for_each(|(e, r)| *e *= r);
     }
@@ -126,12 +136,12 @@ fn loss_region(
     scene: &Scene,
     origin: (isize, isize),
     patch: usize,
-    turns: usize,
+    draw: &Draw,
     border: usize,
 ) -> Vec<f32> {
     let (w, h) = (scene.lf.width, scene.lf.height);
-    let mut texture = crop_plane(&scene.texture, w, h, 1, origin, (patch, patch));
-    for _ in 0..turns % 4 {
+    let mut texture = crop_plane(&scene.texture, w, h, 1, origin, (patch, patch), draw.scale);
+    for _ in 0..draw.turns % 4 {
         texture = rotate_plane(&texture, patch, patch, 1);
     }
     for (i, t) in texture.iter_mut().enumerate() {
@@ -150,7 +160,16 @@ fn target_planes(
     draw: &Draw,
 ) -> (Vec<f32>, Vec<f32>) {
     let ch = t.modes * 2;
-    let mut pairs = crop_plane(&t.pairs, t.width, t.height, ch, origin, (patch, patch));
+    let mut pairs = crop_plane(
+        &t.pairs,
+        t.width,
+        t.height,
+        ch,
+        origin,
+        (patch, patch),
+        draw.scale,
+    );
+    let scale = draw.scale.max(1) as f32;
     for _ in 0..draw.turns % 4 {
         pairs = rotate_plane(&pairs, patch, patch, ch);
     }
@@ -160,7 +179,7 @@ fn target_planes(
     for (i, px) in pairs.chunks_exact(ch).enumerate() {
         for (j, pair) in px.chunks_exact(2).enumerate() {
             if pair[1] > 0.0 {
-                disparity[j * plane + i] = pair[0] - draw.shift;
+                disparity[j * plane + i] = pair[0] / scale - draw.shift;
                 eta[j * plane + i] = pair[1];
             }
         }

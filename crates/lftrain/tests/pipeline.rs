@@ -64,6 +64,7 @@ fn rotated_samples_match_samples_of_the_rendered_rotation() {
     for turns in 1..4 {
         let draw = |turns| Draw {
             origin: (0, 0),
+            scale: 1,
             turns,
             shift: 0.75,
             photometric: Photometric::IDENTITY,
@@ -129,6 +130,7 @@ fn shifting_by_the_disparity_aligns_the_views_and_zeroes_the_target() {
     let scene = Scene::load(dir.path(), "plane", 1, uni()).unwrap();
     let draw = Draw {
         origin: (4, 4),
+        scale: 1,
         turns: 0,
         shift: d,
         photometric: Photometric::IDENTITY,
@@ -144,6 +146,46 @@ fn shifting_by_the_disparity_aligns_the_views_and_zeroes_the_target() {
         let inner = (4..12).contains(&(i % 16)) && (4..12).contains(&(i / 16));
         assert_eq!(e, if inner { 1.0 } else { 0.0 }, "pixel {i}");
     }
+}
+
+/// Down-scaling by 2 (every second pixel) halves the disparity: a plane at d = 2 px is at 1 px
+/// in the sample, so shifting by 1 aligns every view and zeroes the target.
+#[test]
+fn downscaling_halves_the_disparity_of_views_and_targets() {
+    let d = 2.0;
+    let plane = TwoPlanes {
+        front: d,
+        half: 1e6,
+        alpha: 1.0,
+        ..TwoPlanes::new(5, 32)
+    };
+    let dir = tempfile::tempdir().unwrap();
+    plane.write(dir.path(), false).unwrap();
+    let scene = Scene::load(dir.path(), "plane", 1, uni()).unwrap();
+    let draw = |shift| Draw {
+        origin: (4, 4),
+        scale: 2,
+        turns: 0,
+        shift,
+        photometric: Photometric::IDENTITY,
+    };
+    let sample = make_sample(&scene, &draw(d / 2.0), 8, 0);
+    assert!(
+        sample.disparity.iter().all(|t| t.abs() < 1e-6),
+        "{:?}",
+        sample.disparity
+    );
+    let len = 8 * 8 * 3;
+    for (k, stack) in sample.stacks.iter().enumerate() {
+        let centre = &stack[2 * len..3 * len];
+        for v in 0..5 {
+            let diff = max_diff(&stack[v * len..(v + 1) * len], centre);
+            assert!(diff < 0.02, "stack {k} view {v}: {diff}");
+        }
+    }
+    // Shifted by the full-resolution disparity instead, the views disagree.
+    let wrong = make_sample(&scene, &draw(d), 8, 0);
+    assert!(max_diff(&wrong.stacks[0][..len], &wrong.stacks[0][2 * len..3 * len]) > 0.1);
 }
 
 #[test]
@@ -165,6 +207,16 @@ fn random_draws_stay_in_range() {
         // 8 px inside along x (room 24); along y the room (8) allows 4 on each side.
         let d = Draw::random(&cfg, 16, 8, (40, 24), &mut rng);
         assert!((8..=16).contains(&d.origin.0) && d.origin.1 == 4 && d.turns < 4);
+        assert_eq!(d.scale, 1, "a 2× crop (32 px) does not fit 24 rows");
         assert!(d.shift.abs() <= 2.0);
     }
+    // On a 100 × 70 scene every factor up to 4 fits (4 · 16 = 64 ≤ 70), and each crop stays
+    // inside: origin + scale · patch ≤ size.
+    let mut seen = [false; 5];
+    for _ in 0..400 {
+        let d = Draw::random(&cfg, 16, 8, (100, 70), &mut rng);
+        seen[d.scale] = true;
+        assert!(d.origin.0 + d.scale * 16 <= 100 && d.origin.1 + d.scale * 16 <= 70);
+    }
+    assert_eq!(seen, [false, true, true, true, true]);
 }
