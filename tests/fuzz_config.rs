@@ -7,17 +7,15 @@
 //! per-case watchdog; a sample also runs through the `lfgen` binary under a time and
 //! address-space limit, where an abort or a hang would show as a signal or a time-out.
 
-mod bin;
 mod mutate;
 
 use lfgen::config::Config;
 use lfgen::pipeline::{RenderJob, generate_scene};
-use mutate::mutate;
+use mutate::{can_bound, mutate, run_bounded};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 use serde_json::Value;
 use std::path::Path;
-use std::process::Command;
 use std::sync::atomic::AtomicU64;
 use std::sync::mpsc;
 use std::time::Duration;
@@ -169,7 +167,7 @@ fn thousands_of_mutated_configs_are_refused_or_rendered_never_a_panic_or_a_hang(
 /// shrunk to 8×8 by `--set`: every run ends with exit code 0 or 1 and a one-line cause.
 #[test]
 fn mutated_configs_through_the_binary_exit_0_or_1_within_bounds() {
-    if Command::new("prlimit").arg("--version").output().is_err() {
+    if !can_bound() {
         eprintln!("skipped: prlimit (util-linux) is missing");
         return;
     }
@@ -184,35 +182,28 @@ fn mutated_configs_through_the_binary_exit_0_or_1_within_bounds() {
         let path = dir.path().join(format!("config_{case}.toml"));
         std::fs::write(&path, &text).unwrap();
         let out = dir.path().join(format!("out_{case}"));
-        let r = Command::new("timeout")
-            .args(["120", "prlimit", "--as=4294967296", "--cpu=60"])
-            .arg(env!("CARGO_BIN_EXE_lfgen"))
-            .arg("--config")
-            .arg(&path)
-            .args(["--scenes", "1", "--quiet", "--out"])
-            .arg(&out)
-            .args([
-                "--set",
-                "camera.resolution=[8,8]",
-                "--set",
-                "camera.grid=[3,3]",
-            ])
-            .args(["--set", "render.spp=1", "--set", "dataset.date=2026-01-01"])
-            .output()
-            .unwrap();
-        let code = r.status.code();
-        let err = bin::stderr(&r);
-        assert!(
-            matches!(code, Some(0 | 1)),
-            "case {case} ended with {:?}: {err}\n{text}",
-            r.status
-        );
-        if code == Some(1) {
-            assert!(
-                err.starts_with("error: ") && !err.contains("panicked"),
-                "case {case}: {err}"
-            );
+        let mut args = vec![
+            "--config".as_ref(),
+            path.as_os_str(),
+            "--out".as_ref(),
+            out.as_os_str(),
+        ];
+        for a in [
+            "--scenes",
+            "1",
+            "--quiet",
+            "--set",
+            "camera.resolution=[8,8]",
+            "--set",
+            "camera.grid=[3,3]",
+            "--set",
+            "render.spp=1",
+            "--set",
+            "dataset.date=2026-01-01",
+        ] {
+            args.push(a.as_ref());
         }
+        let code = run_bounded(&args, &format!("case {case}:\n{text}"));
         *codes.entry(code).or_insert(0) += 1;
     }
     eprintln!("mutated configs through lfgen: exit codes {codes:?}");

@@ -15,12 +15,11 @@ use lfgen::render::integrator::PathSettings;
 use lfgen::render::view::RenderSettings;
 use lfgen::scene::SceneDesc;
 use lfgen::scene::assets::Assets;
-use mutate::mutate;
+use mutate::{can_bound, mutate, run_bounded};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 use serde_json::Value;
 use std::panic::{AssertUnwindSafe, catch_unwind};
-use std::process::Command;
 use std::sync::atomic::AtomicU64;
 
 /// A small generated scene as JSON: the fuzzer's seed file.
@@ -135,7 +134,7 @@ fn thousands_of_mutated_scene_files_are_refused_or_rendered_never_a_panic() {
 /// ends with exit code 0 or 1, no signal, no time-out.
 #[test]
 fn mutated_scene_files_through_the_binary_exit_0_or_1_within_bounds() {
-    if Command::new("prlimit").arg("--version").output().is_err() {
+    if !can_bound() {
         eprintln!("skipped: prlimit (util-linux) is missing");
         return;
     }
@@ -152,31 +151,16 @@ fn mutated_scene_files_through_the_binary_exit_0_or_1_within_bounds() {
         let path = dir.path().join(format!("scene_{case}.json"));
         std::fs::write(&path, v.to_string()).unwrap();
         let out = dir.path().join(format!("out_{case}"));
-        let r = Command::new("timeout")
-            .args(["120", "prlimit", "--as=4294967296", "--cpu=60"])
-            .arg(env!("CARGO_BIN_EXE_lfgen"))
-            .arg("render")
-            .arg(&path)
-            .arg("--out")
-            .arg(&out)
-            .args(["--set", "render.spp=1", "--quiet"])
-            .output()
-            .unwrap();
-        let code = r.status.code();
-        assert!(
-            matches!(code, Some(0 | 1)),
-            "case {case} ended with {:?}: {}\n{}",
-            r.status,
-            bin::stderr(&r),
-            v
-        );
-        if code == Some(1) {
-            let err = bin::stderr(&r);
-            assert!(
-                err.starts_with("error: ") && !err.contains("panicked"),
-                "case {case}: {err}"
-            );
-        }
+        let args = [
+            "render".as_ref(),
+            path.as_os_str(),
+            "--out".as_ref(),
+            out.as_os_str(),
+            "--set".as_ref(),
+            "render.spp=1".as_ref(),
+            "--quiet".as_ref(),
+        ];
+        let code = run_bounded(&args, &format!("case {case}: {v}"));
         *codes.entry(code).or_insert(0) += 1;
     }
     eprintln!("60 mutated scene.json files through lfgen render: exit codes {codes:?}");

@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{Harness, camera, disparity, emitter, f_px, matte, quad, scene, settings};
+use common::{Harness, Part, camera, disparity, emitter, f_px, matte, quad, scene, settings};
 use glam::{DVec3, Quat, Vec3};
 use lfgen::output::images::to_srgb8;
 use lfgen::scene::{Material, SceneDesc, SurfaceModel, Texture, Transform};
@@ -33,6 +33,17 @@ fn lit_plane(material: Material) -> SceneDesc {
         ..light.transform
     };
     scene(cam, [1.0, 5.0], [0.0; 3], vec![plane, light])
+}
+
+/// Adds `part` to `desc` as object `name` with its own material.
+fn add(desc: &mut SceneDesc, name: &str, part: Part) {
+    desc.materials.push(part.material);
+    desc.objects.push(lfgen::scene::Object {
+        name: name.into(),
+        shape: part.shape,
+        transform: part.transform,
+        material: desc.materials.len() as u32 - 1,
+    });
 }
 
 /// Side of a checker cell: 4 pixels on the plane.
@@ -140,13 +151,7 @@ fn glossy_and_mirror_surfaces_converge_to_the_independent_views() {
         let at = (EYE + DVec3::new(0.0, 0.0, 1.0)).as_vec3();
         let mut wall = quad([6.0, 6.0], at, textured_lambert());
         wall.transform.rotation = Quat::from_rotation_y(std::f32::consts::PI);
-        desc.materials.push(wall.material);
-        desc.objects.push(lfgen::scene::Object {
-            name: "wall".into(),
-            shape: wall.shape,
-            transform: wall.transform,
-            material: desc.materials.len() as u32 - 1,
-        });
+        add(&mut desc, "wall", wall);
         let h = Harness::new(desc);
         let s = settings(256, 5);
         let cache = h.cache(&settings(16, 5), 16);
@@ -192,13 +197,7 @@ fn the_ground_truth_is_the_same_with_shared_and_independent_shading() {
         (EYE + DVec3::new(0.0, 0.0, -1.5)).as_vec3(),
         matte([0.9; 3], 0.5),
     );
-    desc.materials.push(veil.material);
-    desc.objects.push(lfgen::scene::Object {
-        name: "veil".into(),
-        shape: veil.shape,
-        transform: veil.transform,
-        material: desc.materials.len() as u32 - 1,
-    });
+    add(&mut desc, "veil", veil);
     let h = Harness::new(desc);
     let s = settings(8, 4);
     let cache = h.cache(&s, 4);

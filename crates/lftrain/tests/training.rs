@@ -199,10 +199,29 @@ fn tiny_dataset(dir: &std::path::Path) {
     }
 }
 
+/// A quiet run from `train` (validated on `val`) into `out`, both tiny scenes in the pool.
+fn train_args(
+    train: &std::path::Path,
+    val: Option<&std::path::Path>,
+    out: &std::path::Path,
+) -> lftrain::train::TrainArgs {
+    lftrain::train::TrainArgs {
+        train: train.to_path_buf(),
+        val: val.map(std::path::Path::to_path_buf),
+        out: out.to_path_buf(),
+        resume: false,
+        quiet: true,
+        pool: lftrain::loader::PoolConfig {
+            scenes: 2,
+            refresh: 1,
+        },
+        steps: None,
+    }
+}
+
 #[test]
 fn tiny_model_overfits_tiny_dataset_then_predicts_for_lfeval() {
-    use lftrain::loader::PoolConfig;
-    use lftrain::train::{TrainArgs, train};
+    use lftrain::train::train;
 
     let tmp = tempfile::tempdir().unwrap();
     tiny_dataset(tmp.path());
@@ -234,18 +253,7 @@ fn tiny_model_overfits_tiny_dataset_then_predicts_for_lfeval() {
     cfg.augment.colour = lftrain::config::ColourAugment::Off;
     (cfg.augment.brightness_scale, cfg.augment.contrast_scale) = ([1.0; 2], [1.0; 2]);
     let run = tmp.path().join("run");
-    let args = TrainArgs {
-        train: data.clone(),
-        val: Some(data.clone()),
-        out: run.clone(),
-        resume: false,
-        quiet: true,
-        pool: PoolConfig {
-            scenes: 2,
-            refresh: 1,
-        },
-        steps: None,
-    };
+    let args = train_args(&data, Some(&data), &run);
     let t0 = std::time::Instant::now();
     let summary = train(cfg, &args).unwrap();
     let r = &summary.records;
@@ -369,8 +377,7 @@ fn frozen_batch_norm_trains_like_inference_and_keeps_its_statistics() {
 /// used to be accepted and fail inside the crop).
 #[test]
 fn a_patch_larger_than_the_scenes_is_refused_naming_the_scene() {
-    use lftrain::loader::PoolConfig;
-    use lftrain::train::{TrainArgs, train};
+    use lftrain::train::train;
 
     let tmp = tempfile::tempdir().unwrap();
     tiny_dataset(tmp.path());
@@ -380,18 +387,7 @@ fn a_patch_larger_than_the_scenes_is_refused_naming_the_scene() {
         steps: 1,
         ..cfg(ModelKind::Base)
     };
-    let args = TrainArgs {
-        train: tmp.path().join("train"),
-        val: None,
-        out: tmp.path().join("run"),
-        resume: false,
-        quiet: true,
-        pool: PoolConfig {
-            scenes: 2,
-            refresh: 1,
-        },
-        steps: None,
-    };
+    let args = train_args(&tmp.path().join("train"), None, &tmp.path().join("run"));
     let err = format!("{:#}", train(cfg, &args).unwrap_err());
     assert!(
         err.contains("24x24") && err.contains("32x32") && err.contains("train/"),
