@@ -150,6 +150,36 @@ pub struct EseConfig {
     pub delta: f32,
     /// M: inference passes at `s_k = k Δd`, `k = -(M-1)/2 ..= (M-1)/2`.
     pub members: usize,
+    /// Instead of `members`: passes at `lo, lo + step, …` below `hi` across this disparity
+    /// range (mmlf: `arange(-3.5, 3.5, 0.1)`, 70 passes; a wide-baseline scene's whole range).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub range: Option<[f32; 2]>,
+    /// The spacing of those passes (left out: Δd).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step: Option<f32>,
+}
+
+/// Most ESE inference passes (each is one network evaluation of the scene).
+pub const MAX_ESE_PASSES: usize = 10_000;
+
+impl EseConfig {
+    /// The inference shifts, in order.
+    pub fn shifts(&self) -> Vec<f32> {
+        match self.range {
+            Some([lo, hi]) => {
+                let step = self.step.unwrap_or(self.delta);
+                (0..)
+                    .map(|k| lo + k as f32 * step)
+                    .take_while(|s| *s < hi - 1e-6 * step)
+                    .take(MAX_ESE_PASSES + 1)
+                    .collect()
+            }
+            None => {
+                let half = (self.members / 2) as i32;
+                (-half..=half).map(|k| k as f32 * self.delta).collect()
+            }
+        }
+    }
 }
 
 impl Default for EseConfig {
@@ -157,6 +187,8 @@ impl Default for EseConfig {
         Self {
             delta: 1.0,
             members: 7,
+            range: None,
+            step: None,
         }
     }
 }
@@ -342,6 +374,15 @@ impl TrainConfig {
         if self.ese.members == 0 || self.ese.members.is_multiple_of(2) || self.ese.delta <= 0.0 {
             bail!("ese.members must be odd and ese.delta positive");
         }
+        if let Some([lo, hi]) = self.ese.range {
+            let step = self.ese.step.unwrap_or(self.ese.delta);
+            if !(lo.is_finite() && hi.is_finite() && lo < hi && step > 0.0) {
+                bail!("ese.range must be an increasing [min, max] and ese.step positive");
+            }
+            if self.ese.shifts().len() > MAX_ESE_PASSES {
+                bail!("ese.range / ese.step asks for over {MAX_ESE_PASSES} passes");
+            }
+        }
         if !(self.learning_rate > 0.0 && self.lr_decay > 0.0) {
             bail!("learning_rate and lr_decay must be positive");
         }
@@ -480,6 +521,31 @@ mod tests {
         assert_eq!(cfg.texture_threshold, 0.0);
         assert_eq!(cfg.target, UnimodalTarget::Front);
         assert_eq!(cfg.augment.max_downscale, 1);
+    }
+
+    #[test]
+    fn ese_passes_are_symmetric_by_default_or_span_a_range() {
+        let ese = EseConfig::default();
+        assert_eq!(ese.shifts(), vec![-3.0, -2.0, -1.0, 0.0, 1.0, 2.0, 3.0]);
+        // mmlf's inference: arange(-3.5, 3.5, 0.1), 70 passes from -3.5 to 3.4.
+        let mmlf = EseConfig {
+            range: Some([-3.5, 3.5]),
+            step: Some(0.1),
+            ..EseConfig::default()
+        };
+        let s = mmlf.shifts();
+        assert_eq!(s.len(), 70);
+        assert_eq!(s[0], -3.5);
+        assert!((s[69] - 3.4).abs() < 1e-4, "{}", s[69]);
+        // A wide-baseline range at Δd = 1: -40, -39, …, 39.
+        let wide = EseConfig {
+            range: Some([-40.0, 40.0]),
+            ..EseConfig::default()
+        };
+        assert_eq!(wide.shifts().len(), 80);
+        let mut cfg = TrainConfig::default();
+        cfg.ese.range = Some([-1e6, 1e6]);
+        assert!(cfg.validate().unwrap_err().to_string().contains("passes"));
     }
 
     #[test]

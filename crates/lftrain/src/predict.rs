@@ -29,12 +29,6 @@ pub fn run_net(net: &EpiNet, lf: &LightField, shift: f32, device: &Device) -> Ve
         .collect()
 }
 
-/// The ESE's shifts `s_k = k Δd`, `k = -(M-1)/2 ..= (M-1)/2`.
-pub fn ese_shifts(cfg: &TrainConfig) -> Vec<f32> {
-    let half = (cfg.ese.members / 2) as i32;
-    (-half..=half).map(|k| k as f32 * cfg.ese.delta).collect()
-}
-
 /// The prediction of `net` (trained as `cfg.model`) for `lf`, with its runtime.
 pub fn predict(
     cfg: &TrainConfig,
@@ -80,7 +74,7 @@ pub fn predict(
 /// The ESE mixture (thesis eq. 5.9): pass `k` on the light field shifted by `s_k` predicts
 /// `d - s_k`, so its Laplacian is centred at `μ_k + s_k`; all passes weigh `1/M`.
 fn ese_mixture(cfg: &TrainConfig, net: &EpiNet, lf: &LightField, device: &Device) -> PosteriorForm {
-    let shifts = ese_shifts(cfg);
+    let shifts = cfg.ese.shifts();
     let m = shifts.len();
     let pixels = lf.width * lf.height;
     let (mut mu, mut log_b) = (vec![0.0; pixels * m], vec![0.0; pixels * m]);
