@@ -167,13 +167,17 @@ impl GltfFile {
             })
     }
 
-    /// Decodes image `index` (PNG or JPEG, from a buffer view, a file or a data URI).
-    pub fn texture_image(&self, index: u32) -> Result<TextureImage> {
-        let image = self
-            .doc
+    /// Image `index` of the document.
+    fn image(&self, index: u32) -> Result<::gltf::Image<'_>> {
+        self.doc
             .images()
             .nth(index as usize)
-            .with_context(|| format!("image {index} does not exist"))?;
+            .with_context(|| format!("image {index} does not exist"))
+    }
+
+    /// Decodes image `index` (PNG or JPEG, from a buffer view, a file or a data URI).
+    pub fn texture_image(&self, index: u32) -> Result<TextureImage> {
+        let image = self.image(index)?;
         let what = match image.name() {
             Some(name) => format!("image {index} ({name:?})"),
             None => format!("image {index}"),
@@ -190,11 +194,7 @@ impl GltfFile {
     /// What image `index` decodes: its buffer view, or the file or data URI it names (two
     /// images with equal identities are the same texels).
     pub fn image_identity(&self, index: u32) -> Result<String> {
-        let image = self
-            .doc
-            .images()
-            .nth(index as usize)
-            .with_context(|| format!("image {index} does not exist"))?;
+        let image = self.image(index)?;
         Ok(match image.source() {
             ::gltf::image::Source::View { view, .. } => format!("view {}", view.index()),
             ::gltf::image::Source::Uri { uri, .. } if uri.starts_with("data:") => {
