@@ -180,6 +180,9 @@ def cmd_match(a):
     for m, e in zip(desc["materials"], exported):
         m["base_color"] = {"type": "constant", "color": e["color"]}
         m["opacity"] = {"type": "constant", "value": e["opacity"] if a.keep_opacity else 1.0}
+        # Emission maps (skies, facades behind windows) become their mean, as exported.
+        m.pop("emission_map", None)
+        m["emission"] = e["emission"]
         if a.dielectric_only:
             # Diffuse + glossy only: no metals, no glass (the matched setting).
             m["metallic"] = 0.0

@@ -2,14 +2,16 @@
 //! as ratios measured in one run (absolute figures on a shared machine are noise).
 
 use crate::config::{Config, ShadingMode};
-use crate::output::images::to_srgb8;
+use crate::output::images::{ToneCurve, write_linear_exr, write_png};
 use crate::pipeline::{RenderJob, generate_scene};
 use crate::render::framing::auto_exposure;
 use crate::render::integrator::Shading;
+use crate::render::sampler::RayKey;
 use crate::render::view::RenderSettings;
-use anyhow::Result;
+use anyhow::{Context, Result};
 use glam::Vec3;
 use rayon::prelude::*;
+use std::path::Path;
 use std::sync::atomic::AtomicU64;
 use std::time::Instant;
 
@@ -45,7 +47,10 @@ pub fn run(cfg: &Config) -> Result<()> {
                     r.origin,
                     r.dir,
                     f32::INFINITY,
-                    k,
+                    RayKey {
+                        hash: k,
+                        phase: 0.0,
+                    },
                 ));
             }
         })
@@ -122,7 +127,10 @@ const REFERENCE_SPP: u32 = 1024;
 /// `lfgen bench --quality`: for built-in scenes `scenes` at 128², the centre view of the
 /// configured settings, shared and independent side by side, against a converged independent
 /// render: PSNR, the photo-consistency residual of the adjacent view, and the time.
-pub fn quality(cfg: &Config, scenes: &[u64]) -> Result<()> {
+pub fn quality(cfg: &Config, scenes: &[u64], images: Option<&Path>) -> Result<()> {
+    if let Some(dir) = images {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    }
     let mut cfg = cfg.clone();
     cfg.camera.resolution = [QUALITY_RES, QUALITY_RES];
     println!(
@@ -134,18 +142,39 @@ pub fn quality(cfg: &Config, scenes: &[u64]) -> Result<()> {
         let center = cam.center_view();
         let counter = AtomicU64::new(0);
         let mut job = RenderJob::from_config(&cfg, "");
-        let reference = {
-            let settings = RenderSettings {
-                spp: REFERENCE_SPP,
-                ..job.settings(&desc)
-            };
-            scene.render_view(cam, &desc.slices, &settings, center, true, &counter)
+        let converged = RenderSettings {
+            spp: REFERENCE_SPP,
+            ..job.settings(&desc)
         };
+        let reference = scene.render_view(cam, &desc.slices, &converged, center, true, &counter);
         let exposure = desc.exposure * auto_exposure(&reference.image.pixels);
+        let tone = cfg.render.tone_curve;
+        let [w, h] = cam.resolution.map(|n| n as usize);
+        let write = |name: &str, pixels: &[Vec3]| -> Result<()> {
+            let Some(dir) = images else { return Ok(()) };
+            let path = dir.join(format!("scene{index}_{name}"));
+            write_linear_exr(&path.with_extension("exr"), w, h, pixels)?;
+            write_png(&path.with_extension("png"), w, h, pixels, exposure, tone)
+        };
+        write("reference", &reference.image.pixels)?;
         let gt = reference.gt.as_ref().expect("reference has GT");
         let disparity: Vec<f32> = (gt.hci_depth.iter())
             .map(|&z| cam.disparity(z as f64) as f32)
             .collect();
+        // The residual of two converged views: its floor, from resampling alone (texture detail
+        // finer than a pixel does not survive the bilinear lookup of the shifted view).
+        let adjacent =
+            scene.render_view(cam, &desc.slices, &converged, center + 1, false, &counter);
+        let floor = photo_residual(
+            &reference.image.pixels,
+            &adjacent.image.pixels,
+            &disparity,
+            &gt.modes,
+            [w, h],
+            exposure,
+            tone,
+        );
+        println!("{index} | converged ({REFERENCE_SPP} spp) | – | – | {floor:.2} | –");
         for shading in [ShadingMode::Shared, ShadingMode::Independent] {
             job.shading = shading;
             let settings = job.settings(&desc);
@@ -170,12 +199,12 @@ pub fn quality(cfg: &Config, scenes: &[u64]) -> Result<()> {
             let (c, t_view) = render(center);
             let (adjacent, _) = render(center + 1);
             let scene_s = fill + t_view * cam.num_views() as f64;
-            let [w, h] = cam.resolution.map(|n| n as usize);
+            write(&format!("{shading:?}").to_lowercase(), &c)?;
             println!(
                 "{index} | {shading:?} | {:.1} | {:.1} | {:.2} | {scene_s:.1}",
                 psnr_linear(&c, &reference.image.pixels, exposure),
-                psnr_8bit(&c, &reference.image.pixels, exposure),
-                photo_residual(&c, &adjacent, &disparity, &gt.modes, [w, h], exposure),
+                psnr_8bit(&c, &reference.image.pixels, exposure, tone),
+                photo_residual(&c, &adjacent, &disparity, &gt.modes, [w, h], exposure, tone),
             );
         }
     }
@@ -192,8 +221,8 @@ fn psnr_linear(a: &[Vec3], reference: &[Vec3], exposure: f32) -> f64 {
 }
 
 /// PSNR of the 8-bit sRGB images the PNGs hold.
-fn psnr_8bit(a: &[Vec3], reference: &[Vec3], exposure: f32) -> f64 {
-    let (a, r) = (to_srgb8(a, exposure), to_srgb8(reference, exposure));
+fn psnr_8bit(a: &[Vec3], reference: &[Vec3], exposure: f32, tone: ToneCurve) -> f64 {
+    let (a, r) = (tone.encode(a, exposure), tone.encode(reference, exposure));
     let mse = (a.iter().zip(&r))
         .map(|(&x, &y)| (x as f64 - y as f64).powi(2))
         .sum::<f64>()
@@ -212,8 +241,12 @@ fn photo_residual(
     modes: &lfformat::ModeMap,
     [w, h]: [usize; 2],
     exposure: f32,
+    tone: ToneCurve,
 ) -> f64 {
-    let (c8, a8) = (to_srgb8(center, exposure), to_srgb8(adjacent, exposure));
+    let (c8, a8) = (
+        tone.encode(center, exposure),
+        tone.encode(adjacent, exposure),
+    );
     let px = |img: &[u8], x: usize, y: usize, ch: usize| img[(y * w + x) * 3 + ch] as f64;
     let (mut sum, mut n) = (0.0, 0usize);
     for y in 1..h - 1 {

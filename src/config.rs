@@ -5,6 +5,7 @@
 //! deserialising, so a `--set` key goes through the same validation as a key in the file, and
 //! unknown keys are rejected by name instead of being silently ignored.
 
+use crate::output::images::ToneCurve;
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -160,6 +161,8 @@ pub struct RenderConfig {
     pub auto_exposure: bool,
     /// Multiplier applied on top of (auto) exposure.
     pub exposure: f64,
+    /// How the PNGs encode radiance: `agx` (default; highlights roll off) or `clip`.
+    pub tone_curve: ToneCurve,
     /// `shared` (default) or `independent` shading (see [`ShadingMode`]).
     pub shading: ShadingMode,
     /// Shared shading: fill samples per pixel of every view.
@@ -185,6 +188,7 @@ impl Default for RenderConfig {
             write_exr: false,
             auto_exposure: true,
             exposure: 1.0,
+            tone_curve: ToneCurve::Agx,
             shading: ShadingMode::Shared,
             cache_spp: 4,
             cache_cell: 1.0,
@@ -227,7 +231,8 @@ pub struct SceneConfig {
     pub windows: [u32; 2],
     /// Probability of a door in the back wall.
     pub door: f64,
-    /// Luminance range of the daylight seen through windows (linear).
+    /// Luminance range of the sky seen through windows (linear; the outdoor layers in front
+    /// of it emit 0.2–0.6 of it).
     pub window_light: [f64; 2],
     /// Asset catalogue (`catalog.json`) to draw pieces from besides the procedural furniture;
     /// empty: procedural only.

@@ -166,6 +166,10 @@ struct BenchArgs {
     /// Built-in scenes of the quality benchmark.
     #[arg(long, value_delimiter = ',', default_value = "0,1,2")]
     scenes: Vec<u64>,
+    /// Quality benchmark: also write each scene's centre views (reference, shared,
+    /// independent; linear EXR and tone-mapped PNG) into this folder, to look at.
+    #[arg(long)]
+    images: Option<std::path::PathBuf>,
     #[command(flatten)]
     common: ConfigArgs,
 }
@@ -222,7 +226,7 @@ fn run(cli: Cli) -> Result<()> {
         Some(Command::Bench(a)) => {
             let cfg = load(&a.common)?;
             match a.quality {
-                true => lfgen::bench::quality(&cfg, &a.scenes),
+                true => lfgen::bench::quality(&cfg, &a.scenes, a.images.as_deref()),
                 false => lfgen::bench::run(&cfg),
             }
         }

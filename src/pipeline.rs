@@ -2,6 +2,7 @@
 //! for generated scenes, imported glTF scenes and saved `scene.json` files alike.
 
 use crate::config::{BaselineMode, Config, GtViews, ShadingMode, SliceAssignment};
+use crate::output::images::ToneCurve;
 use crate::output::scene_dir::{GtImages, SceneWriter};
 use crate::render::RenderScene;
 use crate::render::framing::auto_exposure;
@@ -24,6 +25,7 @@ pub struct RenderJob {
     pub gt_views: GtViews,
     pub mode_epsilon: f32,
     pub write_exr: bool,
+    pub tone_curve: ToneCurve,
     /// Shade every hit of GT rays (true slice colours).
     pub shade_all_hits: bool,
     /// Slice hits by their surface's depth at the pixel centre.
@@ -52,6 +54,7 @@ impl RenderJob {
             gt_views: r.gt_views,
             mode_epsilon: r.mode_epsilon as f32,
             write_exr: r.write_exr,
+            tone_curve: r.tone_curve,
             shade_all_hits: r.write_slices,
             slice_by_surface: r.slice_assignment == SliceAssignment::Surface,
             auto_exposure: r.auto_exposure,
@@ -124,7 +127,7 @@ pub fn render_scene(
     root: &Path,
     samples_done: &AtomicU64,
 ) -> Result<Vec<FileEntry>> {
-    let writer = SceneWriter::create(final_dir, job.write_exr)?;
+    let writer = SceneWriter::create(final_dir, job.write_exr, job.tone_curve)?;
     let settings = job.settings(desc);
     let center = desc.camera.center_view();
     let per_view = job.gt_views == GtViews::All;

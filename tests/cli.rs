@@ -358,7 +358,7 @@ fn rays_through_windows_and_doors_end_on_a_surface() {
         let scene = out.join(format!("train/scene_{i:04}"));
         let json = fs::read_to_string(scene.join("scene.json")).unwrap();
         // Not every wanted opening fits a narrow room; each scene gets some.
-        let kinds = ["outside_daylight", "outside_corridor"].map(|k| json.contains(k));
+        let kinds = ["outside_sky", "outside_corridor"].map(|k| json.contains(k));
         assert!(kinds.iter().any(|&k| k), "scene {i} has no opening");
         seen = [seen[0] | kinds[0], seen[1] | kinds[1]];
         for view in [0, 4, 8] {

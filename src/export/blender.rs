@@ -9,7 +9,9 @@
 //! `(px, py)` the principal-point offset in pixels (y down). Depth uses the Z pass (planar depth
 //! of the pixel-centre sample at 1 spp).
 
-use super::extract::{DepthVisibility, ExportCamera, ExportScene, mean_color, mean_opacity};
+use super::extract::{
+    DepthVisibility, ExportCamera, ExportScene, mean_color, mean_emission, mean_opacity,
+};
 use super::obj;
 use crate::scene::{Light, SurfaceModel};
 use anyhow::Result;
@@ -50,7 +52,7 @@ pub fn write(scene: &ExportScene, out: &Path, max_depth: u32) -> Result<()> {
             "roughness": m.roughness,
             "metallic": m.metallic,
             "opacity": mean_opacity(&m.opacity),
-            "emission": m.emission,
+            "emission": mean_emission(m).to_array(),
             "depth": match DepthVisibility::of(m) {
                 DepthVisibility::Solid => "solid",
                 DepthVisibility::Invisible => "invisible",

@@ -232,6 +232,13 @@ pub fn mean_color(t: &Texture) -> Vec3 {
     uv_mean(Vec3::ZERO, |uv| t.eval(uv))
 }
 
+/// Mean emitted radiance of a material: what the references get, which have no emission
+/// textures here.
+pub fn mean_emission(m: &Material) -> Vec3 {
+    let map = m.emission_map.as_ref().map_or(Vec3::ONE, mean_color);
+    Vec3::from(m.emission) * map
+}
+
 /// Mean opacity of a material's surface, for renderers that get a uniform opacity instead of
 /// a cut-out pattern.
 pub fn mean_opacity(o: &Opacity) -> f32 {

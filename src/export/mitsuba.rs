@@ -10,7 +10,9 @@
 //! `mi.load_file("scene.xml", spp=1, jitter=False)` for the pixel-centre position AOV.
 
 use super::PathLimits;
-use super::extract::{DepthVisibility, ExportCamera, ExportScene, mean_color, mean_opacity};
+use super::extract::{
+    DepthVisibility, ExportCamera, ExportScene, mean_color, mean_emission, mean_opacity,
+};
 use super::obj;
 use crate::scene::{Light, Material, SurfaceModel};
 use anyhow::Result;
@@ -79,7 +81,7 @@ fn xml(scene: &ExportScene, limits: PathLimits, depth_only: bool) -> String {
             let _ = writeln!(
                 s,
                 "    <emitter type=\"area\"><rgb name=\"radiance\" value=\"{}\"/></emitter>",
-                rgb(Vec3::from(mat.emission))
+                rgb(mean_emission(mat))
             );
         }
         s.push_str("  </shape>\n");

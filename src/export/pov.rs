@@ -15,7 +15,7 @@
 //! mirror keeps dot products, so planar depth is the same expression in both worlds.
 
 use super::extract::{
-    DepthVisibility, ExportCamera, ExportMesh, ExportScene, mean_color, mean_opacity,
+    DepthVisibility, ExportCamera, ExportMesh, ExportScene, mean_color, mean_emission, mean_opacity,
 };
 use crate::config::SliceSpacing;
 use crate::scene::{Light, Opacity, SliceRange, SurfaceModel};
@@ -306,7 +306,7 @@ fn colour_scene(scene: &ExportScene) -> String {
         let mat = scene.material(m);
         let c = mean_color(&mat.base_color);
         let finish = if mat.is_emissive() {
-            let e = Vec3::from(mat.emission);
+            let e = mean_emission(mat);
             format!(
                 "finish {{ emission <{}, {}, {}> diffuse 0 }}",
                 e.x, e.y, e.z
@@ -336,7 +336,7 @@ fn colour_scene(scene: &ExportScene) -> String {
             m.id
         );
         if mat.is_emissive() {
-            area_light(m, Vec3::from(mat.emission), &mut s);
+            area_light(m, mean_emission(mat), &mut s);
         }
     }
     for light in &scene.desc.lights {

@@ -2,9 +2,10 @@
 
 use anyhow::{Context, Result};
 use exr::prelude::{Image, SpecificChannels, Vec2, WritableImage};
-use glam::Vec3;
+use glam::{Mat3, Vec3};
 use image::ImageEncoder;
 use lfformat::files::write_file;
+use serde::{Deserialize, Serialize};
 use std::io::Cursor;
 use std::path::Path;
 
@@ -17,13 +18,70 @@ pub fn linear_to_srgb(v: f32) -> f32 {
     }
 }
 
-/// 8-bit sRGB of linear radiance times `exposure`, clamped.
+/// 8-bit sRGB of linear radiance times `exposure`, clamped (reflectances, texture tiles).
 pub fn to_srgb8(pixels: &[Vec3], exposure: f32) -> Vec<u8> {
-    pixels
-        .iter()
-        .flat_map(|&c| (c * exposure).to_array())
-        .map(|v| (linear_to_srgb(v.clamp(0.0, 1.0)) * 255.0).round() as u8)
-        .collect()
+    ToneCurve::Clip.encode(pixels, exposure)
+}
+
+/// How the views' scene-linear radiance becomes the 8-bit sRGB of their PNGs. The linear EXR
+/// is never tone mapped.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ToneCurve {
+    /// AgX, Blender's default view transform (base look): a log encoding of 16.5 stops
+    /// around middle grey and a sigmoid, so highlights up to 16× diffuse white roll off and
+    /// desaturate towards white instead of clipping, and shadows keep their texture.
+    #[default]
+    Agx,
+    /// The sRGB of the value itself, clipped at display white (the curve before AgX).
+    Clip,
+}
+
+impl ToneCurve {
+    /// 8-bit codes of `pixels × exposure`, three per pixel.
+    pub fn encode(self, pixels: &[Vec3], exposure: f32) -> Vec<u8> {
+        let display = move |c: Vec3| match self {
+            ToneCurve::Agx => agx(c),
+            ToneCurve::Clip => c,
+        };
+        pixels
+            .iter()
+            .flat_map(|&c| display(c * exposure).to_array())
+            .map(|v| (linear_to_srgb(v.clamp(0.0, 1.0)) * 255.0).round() as u8)
+            .collect()
+    }
+}
+
+/// AgX of a scene-linear Rec. 709 colour: display-linear Rec. 709 in [0, 1].
+///
+/// Hand-written because no maintained crate has it (`tonemap` 0.0.4 is from 2020 and has no
+/// AgX); this is the widely used closed form of Blender's AgX (B. Wrensch, "Minimal AgX
+/// implementation", 2023, after T. Sobotka's AgX): the inset matrix, log2 between −12.47 and
+/// +4.03 EV around 0.18, a 6th-order fit of the default contrast sigmoid, the outset matrix,
+/// then the display's 2.2 gamma undone (the caller encodes sRGB).
+fn agx(c: Vec3) -> Vec3 {
+    const MIN_EV: f32 = -12.473_93;
+    const MAX_EV: f32 = 4.026_069;
+    let inset = Mat3::from_cols(
+        Vec3::new(0.842_479_06, 0.042_328_24, 0.042_375_654),
+        Vec3::new(0.078_433_6, 0.878_468_6, 0.078_433_6),
+        Vec3::new(0.079_223_745, 0.079_166_13, 0.879_143),
+    );
+    let outset = Mat3::from_cols(
+        Vec3::new(1.196_879, -0.052_896_85, -0.052_971_635),
+        Vec3::new(-0.098_020_88, 1.151_903_1, -0.098_043_45),
+        Vec3::new(-0.099_029_74, -0.098_961_18, 1.151_073_7),
+    );
+    let log = (inset * c.max(Vec3::splat(1e-10)))
+        .to_array()
+        .map(|v| (v.log2().clamp(MIN_EV, MAX_EV) - MIN_EV) / (MAX_EV - MIN_EV));
+    let sigmoid = |x: f32| {
+        let (x2, x4) = (x * x, x * x * x * x);
+        15.5 * x4 * x2 - 40.14 * x4 * x + 31.96 * x4 - 6.868 * x2 * x + 0.4298 * x2 + 0.1191 * x
+            - 0.002_32
+    };
+    let display = outset * Vec3::from(log.map(sigmoid));
+    display.max(Vec3::ZERO).powf(2.2)
 }
 
 pub fn write_png(
@@ -32,8 +90,10 @@ pub fn write_png(
     height: usize,
     pixels: &[Vec3],
     exposure: f32,
+    tone: ToneCurve,
 ) -> Result<()> {
-    let buf = image::RgbImage::from_raw(width as u32, height as u32, to_srgb8(pixels, exposure))
+    let codes = tone.encode(pixels, exposure);
+    let buf = image::RgbImage::from_raw(width as u32, height as u32, codes)
         .context("image size mismatch")?;
     save_png(&buf, path)
 }
@@ -89,7 +149,7 @@ mod tests {
         let (w, h) = (5, 3);
         let pixels = corners(w, h);
         let png = dir.path().join("v.png");
-        write_png(&png, w, h, &pixels, 1.0).unwrap();
+        write_png(&png, w, h, &pixels, 1.0, ToneCurve::Clip).unwrap();
         let back = image::open(&png).unwrap().to_rgb8();
         assert_eq!(back.dimensions(), (5, 3));
         assert_eq!(back.get_pixel(0, 0).0, [255, 0, 0]);
@@ -106,6 +166,33 @@ mod tests {
         )
         .unwrap();
         assert_eq!(img.layer_data.channel_data.pixels, pixels);
+    }
+
+    /// Against a float64 evaluation of the same closed form (numpy): middle grey lands in the
+    /// middle of the code range, values that clip under `Clip` stay apart below white, white is
+    /// reached at +4.03 EV (16.3), and a saturated highlight desaturates towards white.
+    #[test]
+    fn agx_rolls_highlights_off_instead_of_clipping() {
+        let codes = |v: [f32; 3]| ToneCurve::Agx.encode(&[Vec3::from(v)], 1.0);
+        let cases = [
+            ([0.0; 3], [0; 3]),
+            ([0.01; 3], [18; 3]),
+            ([0.18; 3], [128; 3]),
+            ([1.0; 3], [202; 3]),
+            ([2.0; 3], [224; 3]),
+            ([4.0; 3], [239; 3]),
+            ([16.3; 3], [255; 3]),
+            ([8.0, 0.0, 0.0], [255, 152, 152]),
+        ];
+        for (linear, want) in cases {
+            let got = codes(linear);
+            let near = got
+                .iter()
+                .zip(want)
+                .all(|(&g, w)| (g as i32 - w).abs() <= 1);
+            assert!(near, "{linear:?} → {got:?}, want {want:?}");
+        }
+        assert_eq!(ToneCurve::Clip.encode(&[Vec3::splat(2.0)], 1.0), [255; 3]);
     }
 
     #[test]

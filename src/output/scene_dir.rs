@@ -5,7 +5,7 @@
 //! if it holds nothing but the files a scene writer writes: `--out` pointing at a dataset, a
 //! glTF's own folder or any other folder of the user's is refused before anything renders.
 
-use super::images::{write_linear_exr, write_png};
+use super::images::{ToneCurve, write_linear_exr, write_png};
 use crate::camera::LightFieldCamera;
 use crate::scene::SceneDesc;
 use crate::stats::SceneStats;
@@ -26,6 +26,7 @@ pub struct SceneWriter {
     final_dir: PathBuf,
     tmp_dir: PathBuf,
     write_exr: bool,
+    tone_curve: ToneCurve,
     /// Held until the folder is published (or the writer is dropped on an error).
     _lock: Lock,
 }
@@ -42,7 +43,7 @@ pub struct GtImages<'a> {
 impl SceneWriter {
     /// Starts a scene that will end up at `final_dir`: locks it, checks that whatever is there
     /// may be replaced, and removes a stale partial folder of a killed run.
-    pub fn create(final_dir: &Path, write_exr: bool) -> Result<Self> {
+    pub fn create(final_dir: &Path, write_exr: bool, tone_curve: ToneCurve) -> Result<Self> {
         let name = final_dir
             .file_name()
             .context("scene folder has no name")?
@@ -64,6 +65,7 @@ impl SceneWriter {
             final_dir: final_dir.to_path_buf(),
             tmp_dir,
             write_exr,
+            tone_curve,
             _lock: lock,
         })
     }
@@ -87,6 +89,7 @@ impl SceneWriter {
             height,
             pixels,
             exposure,
+            self.tone_curve,
         )?;
         if self.write_exr {
             write_linear_exr(

@@ -3,7 +3,7 @@
 //! transmittance.
 
 use super::material::RenderMaterial;
-use super::sampler::{mix64, unit_float};
+use super::sampler::RayKey;
 use crate::scene::shapes::MeshTri;
 use anyhow::{Result, bail};
 use glam::{Vec2, Vec3, Vec3A};
@@ -202,15 +202,14 @@ impl Geometry {
     /// Whether the stochastic-transparency test keeps this hit. The decision hashes the ray's
     /// `key` with the triangle, so the same ray sees the same surfaces whichever query asks.
     #[inline]
-    pub fn accepts(&self, mats: &[RenderMaterial], hit: &Hit, key: u64) -> bool {
+    pub fn accepts(&self, mats: &[RenderMaterial], hit: &Hit, key: RayKey) -> bool {
         let uniform = self.leaf_opacity[hit.tri as usize];
         let a = if uniform.is_nan() {
             self.opacity(mats, hit)
         } else {
             uniform
         };
-        a >= 1.0
-            || (a > 0.0 && unit_float(mix64(key ^ self.shading[hit.tri as usize].id as u64)) < a)
+        a >= 1.0 || (a > 0.0 && key.uniform(self.shading[hit.tri as usize].id) < a)
     }
 
     /// Closest hit that passes the stochastic-transparency test for `key`.
@@ -220,7 +219,7 @@ impl Geometry {
         origin: Vec3,
         dir: Vec3,
         tmax: f32,
-        key: u64,
+        key: RayKey,
     ) -> Option<Hit> {
         let ray = Ray::new(origin.into(), dir.into(), 0.0, tmax);
         let mut best = Hit {

@@ -95,6 +95,7 @@ impl RenderScene {
         // and Mitsuba do). A light sample taking all the direct light alone instead would be
         // unbiased too, but fires on glossy surfaces: its pdf knows nothing of the lobe.
         for depth in 0..=settings.max_depth {
+            sampler.start_vertex(depth);
             let Some(h) = hit else {
                 radiance += beta * self.environment;
                 break;
@@ -167,6 +168,9 @@ impl RenderScene {
             if !bs.is_delta {
                 camera_length = None;
             }
+            // A glossy continuation from a cached vertex reads the cache again at its next
+            // non-delta vertex, as a camera path through glass does: only the lobe is per view.
+            pending |= matches!(lobes, Lobes::Specular);
             arrival = Arrival {
                 pdf: bs.pdf * select,
                 is_delta: bs.is_delta,
@@ -208,13 +212,14 @@ impl RenderScene {
         if cos_light <= 0.0 {
             return Vec3::ZERO;
         }
+        let emission = mat.emitted(self.geometry.uv(h));
         if arrival.is_delta {
-            return mat.emission;
+            return emission;
         }
         let light_pdf = self
             .lights
             .pdf(&self.geometry, h.tri, arrival.from, dist, cos_light);
-        mat.emission * power_heuristic(arrival.pdf, light_pdf)
+        emission * power_heuristic(arrival.pdf, light_pdf)
     }
 
     /// One light sample with a shadow ray through semi-transparent surfaces, MIS-weighted

@@ -196,7 +196,9 @@ impl Lights {
             (uv.x, uv.y)
         };
         let p = v[0] + (v[1] - v[0]) * su + (v[2] - v[0]) * sv;
-        let emission = mats[geo.shading[tri as usize].material as usize].emission;
+        let s = &geo.shading[tri as usize];
+        let uv = s.uv[0] * (1.0 - su - sv) + s.uv[1] * su + s.uv[2] * sv;
+        let emission = mats[s.material as usize].emitted(uv);
         LightSample {
             tri,
             p,

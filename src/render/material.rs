@@ -23,7 +23,12 @@ pub struct RenderMaterial {
     pub specular: f32,
     pub roughness: f32,
     pub metallic: f32,
+    /// Mean emitted radiance over the surface: what light selection weighs a triangle by and
+    /// what tells an emitter apart.
     pub emission: Vec3,
+    /// Emitted radiance per point: `emission_scale × map(uv)`; None when uniform
+    /// (`emission` then).
+    emission_map: Option<(Vec3, ColorMap)>,
 }
 
 /// An image with the way a material samples it.
@@ -161,6 +166,17 @@ impl ColorMap {
         }
     }
 
+    /// Mean over the unit UV square (a procedural texture's metre, an image once): a light's
+    /// weight in light selection, where an approximate mean costs variance, never bias.
+    fn mean(&self) -> Vec3 {
+        const N: u32 = 32;
+        let at = |k: u32| (k as f32 + 0.5) / N as f32;
+        let sum: Vec3 = (0..N * N)
+            .map(|k| self.eval(Vec2::new(at(k % N), at(k / N))))
+            .sum();
+        sum / (N * N) as f32
+    }
+
     /// [`Self::eval`] averaged over a footprint `width` metres wide where the map can
     /// (library tiles, through their mip pyramid); other maps are looked up as they are.
     #[inline]
@@ -238,6 +254,11 @@ impl RenderMaterial {
             ))
         };
         let (base_color, opacity) = bind().with_context(|| format!("material {:?}", m.name))?;
+        let scale = Vec3::from(m.emission);
+        let emission_map = match &m.emission_map {
+            Some(t) => Some((scale, ColorMap::bind(t, assets)?)),
+            None => None,
+        };
         Ok(Self {
             uniform_opacity: opacity.uniform(),
             base_color,
@@ -255,8 +276,20 @@ impl RenderMaterial {
                 SurfaceModel::Diffuse => 0.0,
                 SurfaceModel::Standard | SurfaceModel::Glass { .. } => m.metallic,
             },
-            emission: Vec3::from(m.emission),
+            emission: emission_map
+                .as_ref()
+                .map_or(scale, |(scale, map)| *scale * map.mean()),
+            emission_map,
         })
+    }
+
+    /// Radiance emitted at texture coordinate `uv`.
+    #[inline]
+    pub fn emitted(&self, uv: Vec2) -> Vec3 {
+        match &self.emission_map {
+            Some((scale, map)) => *scale * map.eval(uv),
+            None => self.emission,
+        }
     }
 
     /// The BSDF at a surface point.

@@ -1,11 +1,17 @@
-//! Reproducible random numbers: one PCG stream per (seed, scene, view, pixel).
+//! Reproducible sample values: one Owen-scrambled Sobol sequence per (seed, scene, view,
+//! pixel), indexed by the pixel's sample number.
 //!
-//! Deriving the stream from the pixel — not from the thread or the order of work — is what makes
-//! the output byte-identical for any thread count.
+//! Deriving the sequence from the pixel — not from the thread or the order of work — is what
+//! makes the output byte-identical for any thread count. Sobol points (the `sobol_burley`
+//! crate: Burley's hash-based Owen scrambling) stratify every dimension of the path across a
+//! pixel's samples, where independent random numbers clump: the light sample, the lobe choice
+//! and direction, Russian roulette and stochastic transparency all converge faster. Dimensions
+//! come in sets of four, each set with its own scramble and shuffle (Burley's padding, as
+//! Cycles does), so a path may draw any number of them; every vertex starts at a fixed
+//! dimension ([`Sampler::start_vertex`]) so that a dimension means the same decision in every
+//! sample of the pixel.
 
 use glam::Vec2;
-use rand::RngExt;
-use rand_pcg::Pcg32;
 
 /// SplitMix64 finaliser: a cheap, well-mixed 64-bit hash.
 #[inline]
@@ -22,35 +28,85 @@ pub fn unit_float(h: u64) -> f32 {
     (h >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
 }
 
-/// Per-pixel sampler: stratified pixel positions plus a PCG stream for everything else.
+/// Dimensions reserved per path vertex: the light sample (choice and point), the continuation
+/// choice, the lobe choice and direction, Russian roulette and the next ray's transparency
+/// phase, padded to whole sets of four.
+pub const VERTEX_DIMS: u32 = 12;
+
+/// Dimensions of the camera ray (pixel position, transparency phase), before the path's.
+const CAMERA_DIMS: u32 = 4;
+
+/// Longest Sobol sequence `sobol_burley` provides; later samples continue in a fresh scramble.
+const SEQUENCE: u32 = 1 << 16;
+
+/// What decides which semi-transparent surfaces a ray passes (stochastic transparency): a
+/// surface of opacity `a` is kept when `fract(h(hash, surface) + phase) < a`. `hash` is the
+/// same for every sample of a pixel and `phase` a stratified dimension, so for every surface
+/// the kept fraction of a pixel's samples is `a` to within one sample.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayKey {
+    pub hash: u64,
+    pub phase: f32,
+}
+
+impl RayKey {
+    /// The uniform number that surface `id` is tested with.
+    #[inline]
+    pub fn uniform(self, id: u32) -> f32 {
+        (unit_float(mix64(self.hash ^ id as u64)) + self.phase).fract()
+    }
+}
+
+/// A pixel's sampler: sample `index`, next dimension `dim`.
 pub struct Sampler {
-    rng: Pcg32,
+    seed: u64,
+    index: u32,
+    dim: u32,
     strata: [u32; 2],
 }
 
 impl Sampler {
-    /// The stream of pixel `(x, y)` of `view` in scene `scene`.
+    /// The sequence of pixel `(x, y)` of `view` in scene `scene`, with `spp` pixel strata.
     pub fn new(seed: u64, scene: u64, view: u32, x: u32, y: u32, spp: u32) -> Self {
         let key = mix64(mix64(mix64(seed) ^ scene) ^ view as u64);
         let pixel = (y as u64) << 32 | x as u64;
         Self {
-            rng: Pcg32::new(mix64(key ^ pixel), key | 1),
+            seed: mix64(key ^ pixel),
+            index: 0,
+            dim: 0,
             strata: strata(spp),
         }
     }
 
-    /// An independent stream keyed by a 64-bit value (side computations that must not shift
-    /// the pixel's own stream, such as shading hidden slice surfaces).
+    /// An independent sequence keyed by a 64-bit value (side computations that must not shift
+    /// the pixel's own values, such as shading hidden slice surfaces).
     pub fn from_key(key: u64) -> Self {
         Self {
-            rng: Pcg32::new(mix64(key), mix64(!key) | 1),
+            seed: mix64(!key),
+            index: 0,
+            dim: 0,
             strata: [1, 1],
         }
     }
 
+    /// Starts sample `index` of the pixel at its first dimension.
+    #[inline]
+    pub fn start_sample(&mut self, index: u32) {
+        (self.index, self.dim) = (index, 0);
+    }
+
+    /// Moves to the dimensions of path vertex `depth` (after the camera ray's).
+    #[inline]
+    pub fn start_vertex(&mut self, depth: u32) {
+        self.dim = CAMERA_DIMS + depth * VERTEX_DIMS;
+    }
+
     #[inline]
     pub fn next_f32(&mut self) -> f32 {
-        self.rng.random::<f32>()
+        let (set, within) = (self.dim / 4, self.dim % 4);
+        self.dim += 1;
+        let scramble = mix64(self.seed ^ (set as u64) << 32 ^ (self.index / SEQUENCE) as u64);
+        sobol_burley::sample(self.index % SEQUENCE, within, scramble as u32)
     }
 
     #[inline]
@@ -58,15 +114,22 @@ impl Sampler {
         Vec2::new(self.next_f32(), self.next_f32())
     }
 
-    /// A fresh 64-bit key (per-ray decisions that must not depend on traversal order).
+    /// The transparency key of the next ray: a hash of the pixel and the dimension (the same
+    /// in every sample), and a stratified phase.
     #[inline]
-    pub fn next_key(&mut self) -> u64 {
-        self.rng.random::<u64>()
+    pub fn next_key(&mut self) -> RayKey {
+        let hash = mix64(self.seed ^ 0x5EED_0000_0000 ^ self.dim as u64);
+        RayKey {
+            hash,
+            phase: self.next_f32(),
+        }
     }
 
-    /// Jittered position of sample `s` inside the unit pixel (`nx × ny` strata).
+    /// Starts sample `s` and returns its jittered position inside the unit pixel: stratum `s`
+    /// of the `nx × ny` grid, so every stratum holds exactly one sample for any spp.
     #[inline]
     pub fn pixel_offset(&mut self, s: u32) -> Vec2 {
+        self.start_sample(s);
         let [nx, ny] = self.strata;
         let cell = Vec2::new((s % nx) as f32, ((s / nx) % ny) as f32);
         (cell + self.next2()) / Vec2::new(nx as f32, ny as f32)
@@ -103,6 +166,55 @@ mod tests {
             .collect();
         assert_eq!(a, b);
         assert_ne!(a, c);
+    }
+
+    /// Every dimension — in the first set, in padded sets, far along the path — puts exactly
+    /// one of a pixel's first 16 samples in each sixteenth of [0, 1) (the Sobol net property
+    /// that independent random numbers lack), and two pixels get different points.
+    #[test]
+    fn every_dimension_is_stratified_across_a_pixels_samples() {
+        for dim in [0, 3, 5, 13, 50, 200, 300] {
+            let mut seen = [0u32; 16];
+            let mut first = Vec::new();
+            for (x, seen) in [(4, Some(&mut seen)), (5, None)] {
+                let mut s = Sampler::new(1, 2, 3, x, 5, 16);
+                let mut values = Vec::new();
+                for i in 0..16 {
+                    s.start_sample(i);
+                    s.dim = dim;
+                    values.push(s.next_f32());
+                }
+                if let Some(seen) = seen {
+                    values.iter().for_each(|v| seen[(v * 16.0) as usize] += 1);
+                    first = values;
+                } else {
+                    assert_ne!(first, values, "dim {dim}: pixels share their points");
+                }
+            }
+            assert_eq!(seen, [1; 16], "dim {dim}");
+        }
+    }
+
+    /// Stochastic transparency: of a pixel's 16 camera rays, the share that keeps a surface of
+    /// opacity `a` is `a` to within one ray, for every surface (each hashes to its own offset).
+    #[test]
+    fn transparency_keeps_the_opacity_share_of_samples() {
+        for id in [0, 7, 123_456] {
+            for a in [0.1f32, 0.25, 0.5, 0.8] {
+                let mut s = Sampler::new(9, 0, 40, 17, 3, 16);
+                let kept = (0..16)
+                    .filter(|&i| {
+                        s.pixel_offset(i);
+                        s.next_key().uniform(id) < a
+                    })
+                    .count();
+                let want = a * 16.0;
+                assert!(
+                    (kept as f32 - want).abs() <= 1.0,
+                    "id {id}, a {a}: {kept}/16"
+                );
+            }
+        }
     }
 
     #[test]

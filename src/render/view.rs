@@ -5,7 +5,7 @@ use super::RenderScene;
 use super::cache::{CacheGrid, CacheSums, RadianceCache};
 use super::geometry::Hit;
 use super::integrator::{PathSettings, Shading};
-use super::sampler::Sampler;
+use super::sampler::{RayKey, Sampler};
 use super::slices::{SliceAccumulator, SliceHit};
 use crate::camera::{CameraRay, LightFieldCamera, ViewRays};
 use crate::scene::SliceRange;
@@ -278,6 +278,7 @@ impl PixelCtx<'_> {
             );
         }
         for i in 0..s.spp {
+            sampler.start_sample(i);
             let off = camera.pixel_offset(i);
             let ray = self.rays.ray(self.x as f32 + off.x, self.y as f32 + off.y);
             let key = camera.next_key();
@@ -325,7 +326,7 @@ impl PixelCtx<'_> {
         &self,
         origin: Vec3,
         dir: Vec3,
-        key: u64,
+        key: RayKey,
         sampler: &mut Sampler,
         scratch: &mut Scratch,
     ) -> Vec3 {
@@ -347,7 +348,7 @@ impl PixelCtx<'_> {
                     origin,
                     dir,
                     Some(*h),
-                    &mut Sampler::from_key(key ^ i as u64),
+                    &mut Sampler::from_key(key.hash ^ i as u64),
                 )),
                 false => None,
             };

@@ -199,13 +199,19 @@ impl Source {
 
 /// The images a material samples.
 fn image_maps(m: &Material) -> impl Iterator<Item = &ImageMap> {
-    let color = match &m.base_color {
-        Texture::Image { image, .. } => Some(image),
-        _ => None,
-    };
+    fn image(t: &Texture) -> Option<&ImageMap> {
+        match t {
+            Texture::Image { image, .. } => Some(image),
+            _ => None,
+        }
+    }
     let alpha = match &m.opacity {
         Opacity::Image { image, .. } => Some(image),
         _ => None,
     };
-    color.into_iter().chain(alpha)
+    let emission = m.emission_map.as_ref().and_then(image);
+    image(&m.base_color)
+        .into_iter()
+        .chain(alpha)
+        .chain(emission)
 }

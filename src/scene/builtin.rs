@@ -197,6 +197,7 @@ impl Gen<'_> {
             metallic: 0.0,
             opacity,
             emission: [0.0; 3],
+            emission_map: None,
         }
     }
 
@@ -212,6 +213,7 @@ impl Gen<'_> {
             metallic: 0.0,
             opacity: Opacity::constant(1.0),
             emission: [0.0; 3],
+            emission_map: None,
         };
         self.push_material(m)
     }
@@ -484,7 +486,7 @@ impl Gen<'_> {
     }
 
     /// What lies beyond the back wall's openings: their reveals, window panes and bars, a
-    /// corridor behind a door, and the daylight backdrop behind the windows.
+    /// corridor behind a door, and the outdoors behind the windows.
     fn outside(&mut self, size: Vec3, wall: u32) {
         let z = -size.z / 2.0;
         for o in self.openings.clone() {
@@ -492,37 +494,125 @@ impl Gen<'_> {
             match o.kind {
                 OpeningKind::Window => {
                     self.window(&o, z);
-                    self.daylight(&o, z);
+                    self.outdoors(&o, z);
                 }
                 OpeningKind::Door => self.corridor(&o, z, wall),
             }
         }
     }
 
-    /// Daylight behind a window: an emissive plane `dist` outside, just large enough that every
-    /// camera ray through the window meets it (the HCI lens sees at most ~0.4 m sideways per
-    /// metre), so light sampling spends few samples on parts no room point sees.
-    fn daylight(&mut self, o: &Opening, z: f32) {
-        let dist = self.between(0.3, 1.0);
+    /// What a window looks out on: a cloudy sky, a horizon of distant trees, a few buildings
+    /// and sometimes a nearer tree, at depths from 0.4 m to 2.2 m beyond the wall, so a ray
+    /// through the window meets structure that moves with parallax (something for a depth
+    /// method to match) instead of a flat white plane. All of it emits (textured emission)
+    /// rather than being lit: out there nothing would light a face turned to the room, and as
+    /// emitters they light the room as the daylight did. Each layer is just large enough that
+    /// every camera ray through the window meets the sky (the HCI lens sees at most ~0.4 m
+    /// sideways per metre).
+    fn outdoors(&mut self, o: &Opening, z: f32) {
         let kelvin = self.between(5500.0, 7500.0);
-        let light = self.range(self.cfg.scene.window_light);
+        let sky = Vec3::from(kelvin_rgb(kelvin)) * self.range(self.cfg.scene.window_light);
+        let face = z - REVEAL;
+        let dist = self.between(1.4, 2.2);
+        // Half the extent seen around the window at `d` beyond the wall's outer face.
+        let margin = |d: f32| 0.5 * (REVEAL + d) + 0.1;
+        let (cx, cy, h) = (o.centre_x(), (o.y0 + o.y1) / 2.0, o.y1 - o.y0);
+        let size = [o.width() + 2.0 * margin(dist), h + 2.0 * margin(dist)];
+        let clouds = self.noise([0.55, 0.68, 0.95], [1.0; 3], 0.3, 0.8);
+        let m = self.emitter("sky", sky, clouds);
+        let at = Vec3::new(cx, cy, face - dist);
+        self.add("outside_sky", Shape::Quad { size }, Transform::at(at), m);
+        // The horizon: a band of distant woods from below the view up to a random height.
+        let (bottom, horizon) = (cy - size[1] / 2.0, o.y0 + h * self.between(0.05, 0.5));
+        let woods = self.noise([0.10, 0.16, 0.07], [0.32, 0.38, 0.2], 0.03, 0.12);
+        let radiance = sky * self.between(0.2, 0.4);
+        let m = self.emitter("woods", radiance, woods);
+        let at = Vec3::new(cx, (bottom + horizon) / 2.0, face - dist + 0.05);
+        let size = [size[0], horizon - bottom];
+        self.add("outside_woods", Shape::Quad { size }, Transform::at(at), m);
+        for _ in 0..self.rng.random_range(1..=3) {
+            let d = self.between(0.7, dist - 0.2);
+            self.building(o, face - d, margin(d), sky);
+        }
+        if self.chance(0.6) {
+            let front = face - self.between(0.6, 1.2);
+            self.tree(o, front, sky);
+        }
+    }
+
+    /// A building seen through a window, `z` its front, where the view reaches `margin` below
+    /// the sill: a facade of lit wall and darker window panes (a checker) from below the view
+    /// to a top inside the window's height.
+    fn building(&mut self, o: &Opening, z: f32, margin: f32, sky: Vec3) {
+        let (width, depth) = (self.between(0.25, 0.8), 0.3);
+        let x = self.between(o.x0 - 0.2, o.x1 + 0.2);
+        let base = o.y0 - margin;
+        let top = o.y0 + (o.y1 - o.y0) * self.between(0.15, 0.9);
+        let wall = self.color().map(|c| 0.4 + 0.6 * c);
+        let facade = Texture::Checker {
+            a: wall,
+            b: [0.18, 0.22, 0.3],
+            size: self.between(0.03, 0.08),
+        };
+        let radiance = sky * self.between(0.25, 0.6);
+        let m = self.emitter("building", radiance, facade);
+        let at = Vec3::new(x, (base + top) / 2.0, z - depth / 2.0);
+        let size = Vec3::new(width, top - base, depth);
+        self.add(
+            "outside_building",
+            Shape::Cuboid { size },
+            Transform::at(at),
+            m,
+        );
+    }
+
+    /// A nearer tree, `z` the front of its crown: a noisy green sphere on a dark trunk.
+    fn tree(&mut self, o: &Opening, z: f32, sky: Vec3) {
+        let r = self.between(0.15, 0.35);
+        let x = self.between(o.x0, o.x1);
+        let y = o.y0 + (o.y1 - o.y0) * self.between(0.2, 0.6);
+        let leaves = self.noise([0.06, 0.14, 0.04], [0.25, 0.42, 0.12], 0.02, 0.06);
+        let radiance = sky * self.between(0.2, 0.4);
+        let m = self.emitter("tree", radiance, leaves);
+        let crown = Shape::Sphere {
+            radius: r,
+            rings: 12,
+            segments: 16,
+        };
+        let centre = Vec3::new(x, y, z - r);
+        self.add("outside_tree", crown, Transform::at(centre), m);
+        let bark = Texture::constant([0.12, 0.09, 0.07]);
+        let m = self.emitter("trunk", sky * 0.2, bark);
+        let trunk = Shape::Cylinder {
+            radius: 0.03,
+            height: y,
+            segments: 8,
+        };
+        let foot = Vec3::new(x, 0.0, centre.z);
+        self.add("outside_tree", trunk, Transform::at(foot), m);
+    }
+
+    /// Value noise between `a` and `b` with a feature size drawn from `[lo, hi]` metres.
+    fn noise(&mut self, a: [f32; 3], b: [f32; 3], lo: f32, hi: f32) -> Texture {
+        Texture::Noise {
+            a,
+            b,
+            scale: self.between(lo, hi),
+            seed: self.rng.random(),
+        }
+    }
+
+    /// An emissive material radiating `radiance × map(uv)`.
+    fn emitter(&mut self, name: &str, radiance: Vec3, map: Texture) -> u32 {
         let mut m = self.standard(
-            "daylight",
+            name,
             Texture::constant([0.8; 3]),
             1.0,
             Opacity::constant(1.0),
         );
-        m.emission = kelvin_rgb(kelvin).map(|c| c * light);
-        let m = self.push_material(m);
-        let margin = 0.5 * (REVEAL + dist) + 0.1;
-        let size = [o.width() + 2.0 * margin, o.y1 - o.y0 + 2.0 * margin];
-        let at = Vec3::new(o.centre_x(), (o.y0 + o.y1) / 2.0, z - REVEAL - dist);
-        self.add(
-            "outside_daylight",
-            Shape::Quad { size },
-            Transform::at(at),
-            m,
-        );
+        m.emission = radiance.to_array();
+        m.emission_map = Some(map);
+        self.push_material(m)
     }
 
     /// The four faces of the wall's thickness around an opening, facing into it.
@@ -1172,7 +1262,41 @@ mod tests {
         }
     }
 
-    /// Openings appear, the back wall has exactly their holes, windows have daylight behind
+    /// Behind every window: a sky, and emitting layers at more than one depth in front of it,
+    /// every one of them textured (structure for a depth method), all beyond the wall.
+    #[test]
+    fn windows_look_out_on_textured_layers_at_several_depths() {
+        let mut windows = 0;
+        for seed in 0..20 {
+            let desc = generate(&cfg(seed), seed, None);
+            let wall = desc.objects.iter().find(|o| o.name == "wall_back").unwrap();
+            let z_wall = wall.transform.translation.z;
+            let outside: Vec<_> = (desc.objects.iter())
+                .filter(|o| desc.materials[o.material as usize].is_emissive())
+                .filter(|o| o.transform.translation.z < z_wall - REVEAL)
+                .collect();
+            let skies = outside.iter().filter(|o| o.name == "outside_sky").count();
+            windows += skies;
+            for o in &outside {
+                let m = &desc.materials[o.material as usize];
+                assert!(m.emission_map.is_some(), "seed {seed}: {} is flat", o.name);
+            }
+            let mut depths: Vec<f32> = outside.iter().map(|o| o.transform.translation.z).collect();
+            depths.sort_by(f32::total_cmp);
+            depths.dedup_by(|a, b| (*a - *b).abs() < 0.05);
+            if skies > 0 {
+                assert!(
+                    outside.len() >= 3 * skies,
+                    "seed {seed}: {} layers",
+                    outside.len()
+                );
+                assert!(depths.len() >= 3, "seed {seed}: depths {depths:?}");
+            }
+        }
+        assert!(windows >= 10, "{windows} windows");
+    }
+
+    /// Openings appear, the back wall has exactly their holes, windows have a sky behind
     /// them, and no piece hangs across a window or stands in a doorway.
     #[test]
     fn openings_are_cut_lit_and_kept_clear() {
@@ -1186,7 +1310,7 @@ mod tests {
             else {
                 panic!("the back wall is a wall with holes");
             };
-            let daylight = desc.objects.iter().any(|o| o.name == "outside_daylight");
+            let daylight = desc.objects.iter().any(|o| o.name == "outside_sky");
             let mut lit = false;
             for h in holes {
                 let (x0, x1, y0, y1) = (h[0], h[2], h[1] + size[1] / 2.0, h[3] + size[1] / 2.0);
@@ -1214,10 +1338,7 @@ mod tests {
                     }
                 }
             }
-            assert_eq!(
-                lit, daylight,
-                "seed {seed}: daylight exactly behind windows"
-            );
+            assert_eq!(lit, daylight, "seed {seed}: a sky exactly behind windows");
         }
         assert!(
             windows >= 10 && doors >= 3,

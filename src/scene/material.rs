@@ -19,6 +19,10 @@ pub struct Material {
     pub opacity: Opacity,
     /// Emitted radiance (linear RGB); non-zero makes the surface an area light.
     pub emission: [f32; 3],
+    /// Where the emission varies over the surface (a cloudy sky, a lit facade): the radiance
+    /// at a point is `emission × emission_map(uv)`. None: uniform.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub emission_map: Option<Texture>,
 }
 
 /// The scattering model of a material.

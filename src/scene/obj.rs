@@ -231,6 +231,7 @@ impl ObjFile {
             metallic: 0.0,
             opacity: Opacity::constant(1.0),
             emission: [0.0; 3],
+            emission_map: None,
         }
     }
 
@@ -431,5 +432,6 @@ fn convert(m: &tobj::Material, maps: &[Option<u32>; 2], source: u32) -> Material
         metallic: 0.0,
         opacity,
         emission,
+        emission_map: None,
     }
 }

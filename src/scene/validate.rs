@@ -5,7 +5,7 @@
 //! field and the value, so the error points at the line to fix, and the bounds keep a bad
 //! number from allocating gigabytes or looping for hours.
 
-use super::{Material, Object, Opacity, SceneDesc, Shape, SliceRange, SurfaceModel};
+use super::{Material, Object, Opacity, SceneDesc, Shape, SliceRange, SurfaceModel, Texture};
 use crate::camera::LightFieldCamera;
 use crate::config::{MAX_GRID, MAX_SLICES};
 use crate::render::MAX_TRIANGLES;
@@ -159,6 +159,11 @@ fn check_material(m: &Material) -> Result<()> {
         m.base_color.is_valid(),
         "base_color {:?}: colours must be finite and non-negative, sizes positive",
         m.base_color
+    );
+    ensure!(
+        m.emission_map.as_ref().is_none_or(Texture::is_valid),
+        "emission_map {:?}: colours must be finite and non-negative, sizes positive",
+        m.emission_map
     );
     Ok(())
 }

@@ -60,6 +60,7 @@ pub fn matte(color: [f32; 3], opacity: f32) -> Material {
         metallic: 0.0,
         opacity: Opacity::constant(opacity),
         emission: [0.0; 3],
+        emission_map: None,
     }
 }
 

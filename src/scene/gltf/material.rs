@@ -26,6 +26,7 @@ pub(super) fn default_material() -> Material {
         metallic: 1.0,
         opacity: Opacity::constant(1.0),
         emission: [0.0; 3],
+        emission_map: None,
     }
 }
 
@@ -82,6 +83,7 @@ fn material(
         metallic: pbr.metallic_factor(),
         opacity: opacity(m.alpha_mode(), m.alpha_cutoff(), alpha, map),
         emission: emission(file, m)?.to_array(),
+        emission_map: None,
     };
     Ok((material, uv_set))
 }
