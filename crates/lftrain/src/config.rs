@@ -163,12 +163,30 @@ pub struct EseConfig {
     /// The spacing of those passes (left out: Δd).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub step: Option<f32>,
+    /// Without `range`: the passes span each scene's `parameters.cfg` range (`disp_min`,
+    /// `disp_max`) at `step` — the thesis recommends ESE for wide baselines, whose range a
+    /// fixed ±3 does not reach. Scenes without a range keep `members`.
+    #[serde(default)]
+    pub scene_range: bool,
 }
 
 /// Most ESE inference passes (each is one network evaluation of the scene).
 pub const MAX_ESE_PASSES: usize = 10_000;
 
 impl EseConfig {
+    /// The inference shifts of a scene whose `parameters.cfg` range is `scene`: `range` if
+    /// set, else with `scene_range` the scene's range, else [`EseConfig::shifts`].
+    pub fn scene_shifts(&self, scene: Option<[f32; 2]>) -> Vec<f32> {
+        match (self.range, scene) {
+            (None, Some(r)) if self.scene_range => EseConfig {
+                range: Some(r),
+                ..self.clone()
+            }
+            .shifts(),
+            _ => self.shifts(),
+        }
+    }
+
     /// The inference shifts, in order.
     pub fn shifts(&self) -> Vec<f32> {
         match self.range {
@@ -195,6 +213,7 @@ impl Default for EseConfig {
             members: 7,
             range: None,
             step: None,
+            scene_range: false,
         }
     }
 }
@@ -703,6 +722,65 @@ mod tests {
         let mut cfg = TrainConfig::default();
         cfg.ese.range = Some([-1e6, 1e6]);
         assert!(cfg.validate().unwrap_err().to_string().contains("passes"));
+    }
+
+    #[test]
+    fn ese_passes_can_span_each_scenes_range() {
+        let wide = Some([-40.1, 40.1]);
+        let ese = EseConfig::default();
+        assert_eq!(ese.scene_shifts(wide).len(), 7, "off by default");
+        let on = EseConfig {
+            scene_range: true,
+            ..ese
+        };
+        let s = on.scene_shifts(wide);
+        assert_eq!((s.len(), s[0]), (81, -40.1));
+        assert!((s[80] - 39.9).abs() < 1e-3, "{}", s[80]);
+        assert_eq!(on.scene_shifts(None).len(), 7);
+        let fixed = EseConfig {
+            range: Some([-1.0, 1.0]),
+            ..on
+        };
+        assert_eq!(fixed.scene_shifts(wide), vec![-1.0, 0.0]);
+    }
+
+    #[test]
+    fn epishift_defaults_are_the_thesis_and_the_cpu_recipe_parses() {
+        let cfg = TrainConfig {
+            model: ModelKind::EpiShift,
+            ..TrainConfig::default()
+        };
+        cfg.validate().unwrap();
+        let e = &cfg.epishift;
+        assert_eq!(
+            (
+                e.feature_width,
+                e.feature_blocks,
+                e.unet_width,
+                e.unet_depth
+            ),
+            (64, 4, 64, 5)
+        );
+        assert_eq!(
+            (e.epsilon, e.alpha, e.class_target),
+            (0.17, 2.5, ClassTarget::Rectangle)
+        );
+        assert_eq!(e.train_offsets(), vec![-3, -2, -1, 0, 1, 2, 3]);
+        assert_eq!(cfg.loss_border(), 9);
+        let recipe: TrainConfig =
+            toml::from_str(include_str!("../configs/epishift_cpu.toml")).unwrap();
+        recipe.validate().unwrap();
+        assert_eq!(recipe.model, ModelKind::EpiShift);
+        let bad = |f: fn(&mut TrainConfig)| {
+            let mut c = cfg.clone();
+            f(&mut c);
+            c.validate().unwrap_err().to_string()
+        };
+        assert!(bad(|c| c.patch = 100).contains("2^unet_depth"));
+        assert!(bad(|c| c.multimodal = true).contains("multimodal"));
+        assert!(bad(|c| c.epishift.train_shifts = 4).contains("odd"));
+        assert!(bad(|c| c.epishift.range = Some([-1e6, 1e6])).contains("shifts"));
+        assert!(bad(|c| c.epishift.unet_depth = 8).contains("channels"));
     }
 
     #[test]

@@ -114,7 +114,7 @@ fn predict_epinet(
 /// The ESE mixture (thesis eq. 5.9): pass `k` on the light field shifted by `s_k` predicts
 /// `d - s_k`, so its Laplacian is centred at `μ_k + s_k`; all passes weigh `1/M`.
 fn ese_mixture(cfg: &TrainConfig, net: &EpiNet, lf: &LightField, device: &Device) -> PosteriorForm {
-    let shifts = cfg.ese.shifts();
+    let shifts = cfg.ese.scene_shifts(lf.disparity_range);
     let m = shifts.len();
     let pixels = lf.width * lf.height;
     let (mut mu, mut log_b) = (vec![0.0; pixels * m], vec![0.0; pixels * m]);
