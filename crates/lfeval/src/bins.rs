@@ -28,6 +28,36 @@ impl Bins {
         count: 108,
     };
 
+    /// Most bins [`Bins::covering`] makes: ±40 px at the thesis' width needs 1 235.
+    pub const MAX_COVERING: usize = 100_000;
+
+    /// Bins of the thesis' width (7/108 px, below BadPix's 0.07) over the union of `ranges`
+    /// (each scene's `[disp_min, disp_max]`), or `count` bins over it: KLD and discrete
+    /// posteriors for wide-baseline data (±40 px) whose modes the thesis' ±3.5 px would pile
+    /// into the two open-ended outer bins.
+    pub fn covering(
+        ranges: impl IntoIterator<Item = (f64, f64)>,
+        count: Option<usize>,
+    ) -> Result<Self, String> {
+        let (min, max) = ranges
+            .into_iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), (a, b)| {
+                (lo.min(a), hi.max(b))
+            });
+        if !(min.is_finite() && max.is_finite()) {
+            return Err("no finite disparity range to cover".into());
+        }
+        let width = Self::THESIS.width();
+        let count = count.unwrap_or_else(|| ((max - min) / width).ceil().max(1.0) as usize);
+        if count > Self::MAX_COVERING {
+            return Err(format!(
+                "[{min}, {max}] needs {count} bins, over {}",
+                Self::MAX_COVERING
+            ));
+        }
+        Self::new(min, max, count)
+    }
+
     /// Validated bins; the message says what is wrong.
     pub fn new(min: f64, max: f64, count: usize) -> Result<Self, String> {
         if !(min.is_finite() && max.is_finite() && min < max) {
@@ -128,6 +158,22 @@ mod tests {
         assert_eq!(b.open_interval(3), (3.0, f64::INFINITY));
         let one = Bins::new(0.0, 1.0, 1).unwrap();
         assert_eq!(one.open_interval(0), (f64::NEG_INFINITY, f64::INFINITY));
+    }
+
+    #[test]
+    fn covering_bins_span_all_ranges_at_the_thesis_width() {
+        let b = Bins::covering([(-39.7, 37.7), (-3.6, 3.4), (-40.1, 12.0)], None).unwrap();
+        assert_eq!((b.min, b.max), (-40.1, 37.7));
+        assert!(
+            b.width() <= Bins::THESIS.width() && b.width() > 0.064,
+            "{}",
+            b.width()
+        );
+        assert_eq!(b.count, 1201);
+        let fixed = Bins::covering([(-1.0, 1.0)], Some(4)).unwrap();
+        assert_eq!((fixed.count, fixed.width()), (4, 0.5));
+        assert!(Bins::covering([], None).is_err());
+        assert!(Bins::covering([(0.0, 1e9)], None).is_err());
     }
 
     #[test]

@@ -8,7 +8,7 @@ use clap::{Args, Parser, Subcommand};
 use lfeval::baseline::views::ViewSet;
 use lfeval::baseline::{BaselineConfig, DEFAULT_TEMPERATURE, DEFAULT_WINDOW};
 use lfeval::bins::Bins;
-use lfeval::dataset::{SceneDir, discover};
+use lfeval::dataset::{PARAMETERS_FILE, SceneDir, discover};
 use lfeval::metrics::kld::EPSILON;
 use lfeval::pipeline::{self, EvalOptions};
 use lfeval::prediction::Method;
@@ -59,18 +59,43 @@ struct Common {
 /// The disparity bins.
 #[derive(Args)]
 struct BinArgs {
-    /// Number of disparity bins.
-    #[arg(long, default_value_t = Bins::THESIS.count)]
-    bins: usize,
-    /// Disparity range MIN,MAX of the bins, pixels.
-    #[arg(long, value_name = "MIN,MAX", default_value = "-3.5,3.5", allow_hyphen_values = true,
+    /// Number of disparity bins (default: 108; with --range auto, as many as keep the
+    /// thesis' width of 7/108 px).
+    #[arg(long)]
+    bins: Option<usize>,
+    /// Disparity range MIN,MAX of the bins, pixels, or `auto`: the union of the scenes'
+    /// parameters.cfg ranges (disp_min, disp_max), for wide baselines.
+    #[arg(long, value_name = "MIN,MAX|auto", default_value = "-3.5,3.5", allow_hyphen_values = true,
           value_parser = parse_range)]
-    range: (f64, f64),
+    range: RangeArg,
+}
+
+/// `--range`: fixed, or the scenes' own.
+#[derive(Clone, Copy, Debug)]
+enum RangeArg {
+    Fixed(f64, f64),
+    Auto,
 }
 
 impl BinArgs {
-    fn bins(&self) -> Result<Bins> {
-        Bins::new(self.range.0, self.range.1, self.bins).map_err(anyhow::Error::msg)
+    /// The bins for `scenes` (their `parameters.cfg` ranges with `--range auto`).
+    fn bins(&self, scenes: &[SceneDir]) -> Result<Bins> {
+        match self.range {
+            RangeArg::Fixed(min, max) => {
+                Bins::new(min, max, self.bins.unwrap_or(Bins::THESIS.count))
+                    .map_err(anyhow::Error::msg)
+            }
+            RangeArg::Auto => {
+                let ranges = scenes
+                    .iter()
+                    .map(|s| {
+                        let p = lfformat::HciParameters::read(&s.path.join(PARAMETERS_FILE))?;
+                        Ok((p.disp_min, p.disp_max))
+                    })
+                    .collect::<Result<Vec<_>>>()?;
+                Bins::covering(ranges, self.bins).map_err(|m| anyhow::anyhow!("--range auto: {m}"))
+            }
+        }
     }
 }
 
@@ -159,10 +184,14 @@ struct TruthArgs {
     eta: EtaKind,
 }
 
-fn parse_range(s: &str) -> Result<(f64, f64), String> {
-    let bad = || format!("expected MIN,MAX such as -3.5,3.5, got {s:?}");
+/// `MIN,MAX`, or `auto` (the scenes' own ranges).
+fn parse_range(s: &str) -> Result<RangeArg, String> {
+    if s.trim() == "auto" {
+        return Ok(RangeArg::Auto);
+    }
+    let bad = || format!("expected MIN,MAX such as -3.5,3.5 or auto, got {s:?}");
     let (a, b) = s.split_once(',').ok_or_else(bad)?;
-    Ok((
+    Ok(RangeArg::Fixed(
         a.trim().parse().map_err(|_| bad())?,
         b.trim().parse().map_err(|_| bad())?,
     ))
@@ -207,7 +236,7 @@ fn evaluate(a: EvalArgs) -> Result<()> {
     }
     let opts = EvalOptions {
         config: EvalConfig {
-            bins: a.bins.bins()?,
+            bins: a.bins.bins(&scenes)?,
             epsilon: a.epsilon,
             border: a.border,
             eta: a.eta,
@@ -237,7 +266,7 @@ fn baseline(a: BaselineArgs) -> Result<()> {
         anyhow::bail!("--temperature must be positive, got {}", a.temperature);
     }
     let cfg = BaselineConfig {
-        bins: a.bins.bins()?,
+        bins: a.bins.bins(&scenes)?,
         views: a.views,
         temperature: a.temperature,
         window: a.window,
@@ -254,6 +283,6 @@ fn baseline(a: BaselineArgs) -> Result<()> {
 
 fn truth(a: TruthArgs) -> Result<()> {
     let scenes = setup(&a.dataset, &a.common)?;
-    let settings = (a.reference, a.eta, a.bins.bins()?);
+    let settings = (a.reference, a.eta, a.bins.bins(&scenes)?);
     pipeline::truth_dataset(&a.dataset, &scenes, &a.out, settings, a.common.quiet)
 }

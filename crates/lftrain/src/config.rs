@@ -7,7 +7,7 @@ use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
 use serde::{Deserialize, Serialize};
 
-/// The four posterior models of the thesis (§5.2.1).
+/// The four posterior models of the thesis (§5.2.1) and EPI-Shift (chapter 4).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum ModelKind {
@@ -19,6 +19,10 @@ pub enum ModelKind {
     Ese,
     /// Discrete posterior prediction: a softmax over disparity bins.
     Dpp,
+    /// EPI-Shift (thesis §4.2): a classification and an offset per integer EPI shift, for
+    /// disparity ranges far beyond the training data's.
+    #[value(name = "epishift")]
+    EpiShift,
 }
 
 impl ModelKind {
@@ -26,7 +30,7 @@ impl ModelKind {
     pub fn out_channels(self, dpp_bins: usize) -> usize {
         match self {
             ModelKind::Base => 1,
-            ModelKind::Upr | ModelKind::Ese => 2,
+            ModelKind::Upr | ModelKind::Ese | ModelKind::EpiShift => 2,
             ModelKind::Dpp => dpp_bins,
         }
     }
@@ -38,6 +42,7 @@ impl ModelKind {
             ModelKind::Upr => "upr",
             ModelKind::Ese => "ese",
             ModelKind::Dpp => "dpp",
+            ModelKind::EpiShift => "epishift",
         }
     }
 }
@@ -95,6 +100,7 @@ impl Default for NetConfig {
 #[serde(default, deny_unknown_fields)]
 pub struct AugmentConfig {
     /// Random EPI shift drawn uniformly from `[-max_shift, max_shift]` pixels (thesis: 2).
+    /// EPI-Shift rounds it to an integer base shift (its shifts must stay integer).
     pub max_shift: f32,
     /// Random integer down-scaling by 1 ..= this factor, taking every k-th pixel (mmlf's
     /// `RandomDownSampling(4)`); the disparities shrink by k. 1: off.
@@ -157,12 +163,30 @@ pub struct EseConfig {
     /// The spacing of those passes (left out: Δd).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub step: Option<f32>,
+    /// Without `range`: the passes span each scene's `parameters.cfg` range (`disp_min`,
+    /// `disp_max`) at `step` — the thesis recommends ESE for wide baselines, whose range a
+    /// fixed ±3 does not reach. Scenes without a range keep `members`.
+    #[serde(default)]
+    pub scene_range: bool,
 }
 
 /// Most ESE inference passes (each is one network evaluation of the scene).
 pub const MAX_ESE_PASSES: usize = 10_000;
 
 impl EseConfig {
+    /// The inference shifts of a scene whose `parameters.cfg` range is `scene`: `range` if
+    /// set, else with `scene_range` the scene's range, else [`EseConfig::shifts`].
+    pub fn scene_shifts(&self, scene: Option<[f32; 2]>) -> Vec<f32> {
+        match (self.range, scene) {
+            (None, Some(r)) if self.scene_range => EseConfig {
+                range: Some(r),
+                ..self.clone()
+            }
+            .shifts(),
+            _ => self.shifts(),
+        }
+    }
+
     /// The inference shifts, in order.
     pub fn shifts(&self) -> Vec<f32> {
         match self.range {
@@ -189,6 +213,7 @@ impl Default for EseConfig {
             members: 7,
             range: None,
             step: None,
+            scene_range: false,
         }
     }
 }
@@ -212,6 +237,146 @@ impl Default for DppConfig {
             min: -3.5,
             max: 3.5,
         }
+    }
+}
+
+/// The classification ground truth `C_true^s` of EPI-Shift (thesis eq. 4.7, 4.8).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ClassTarget {
+    /// 1 where `|d − s| ≤ 0.5 + ε`, else 0 (eq. 4.7; the thesis' choice, Table 4.1).
+    Rectangle,
+    /// `max(0.5 + ε − |d − s|, 0)` (eq. 4.8).
+    Triangle,
+}
+
+/// EPI-Shift (thesis §4.2): network shape, losses and inference shifts. The defaults are the
+/// thesis' settings.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct EpiShiftConfig {
+    /// Channels of the siamese feature extractor (64).
+    pub feature_width: usize,
+    /// Blocks of the feature extractor, each two 3×3 convolutions with ReLU and BN (4).
+    pub feature_blocks: usize,
+    /// Channels of the U-Net's top level, to which the concatenated features are reduced (64).
+    pub unet_width: usize,
+    /// Down-sampling steps of the U-Net (5); every level doubles the channels. Training
+    /// crops must be a multiple of `2^unet_depth`.
+    pub unet_depth: usize,
+    /// Integer shifts per training crop, centred on the crop's (integer) base shift (7).
+    pub train_shifts: usize,
+    /// Classification ground truth (eq. 4.7 or 4.8).
+    pub class_target: ClassTarget,
+    /// ε of the classification ground truth (0.17).
+    pub epsilon: f32,
+    /// ε of the rectangle that masks the regression loss (eq. 4.9): "slightly higher" than
+    /// `epsilon`; the thesis gives no value.
+    pub reg_epsilon: f32,
+    /// α of `L = α L_reg + L_class` (eq. 4.10; 2.5).
+    pub alpha: f32,
+    /// Refinement (eq. 4.11): where no `C^s` reaches this, the shift is chosen on
+    /// median-filtered classification maps (0.01; 0: off).
+    pub refine_threshold: f32,
+    /// Side of that median filter (odd; the thesis gives no size).
+    pub median_window: usize,
+    /// Disparity range the inference shifts cover; left out: each scene's
+    /// `parameters.cfg` range (`disp_min`, `disp_max`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub range: Option<[f32; 2]>,
+}
+
+impl Default for EpiShiftConfig {
+    fn default() -> Self {
+        Self {
+            feature_width: 64,
+            feature_blocks: 4,
+            unet_width: 64,
+            unet_depth: 5,
+            train_shifts: 7,
+            class_target: ClassTarget::Rectangle,
+            epsilon: 0.17,
+            reg_epsilon: 0.25,
+            alpha: 2.5,
+            refine_threshold: 0.01,
+            median_window: 5,
+            range: None,
+        }
+    }
+}
+
+/// Most inference shifts of one EPI-Shift scene (each is one network evaluation).
+pub const MAX_SHIFTS: usize = 10_000;
+/// Widest EPI-Shift layer or feature (the thesis: 64 at the top, 2048 at depth 5).
+pub const MAX_EPISHIFT_WIDTH: usize = 4096;
+
+impl EpiShiftConfig {
+    /// The integer shifts covering disparities `[lo, hi]`: shift `s` serves `|d − s| ≤ 0.5`,
+    /// so `round(lo) ..= round(hi)`.
+    pub fn shifts_for(lo: f32, hi: f32) -> Vec<i32> {
+        (lo.round() as i32..=hi.round() as i32).collect()
+    }
+
+    /// The shifts of a training crop relative to its base shift: `-K ..= K`.
+    pub fn train_offsets(&self) -> Vec<i32> {
+        let k = (self.train_shifts / 2) as i32;
+        (-k..=k).collect()
+    }
+
+    /// Pixels on each side of an output pixel that reach it through the feature extractor and
+    /// the reduction (two 3×3 convolutions per block, one more): the EPI features are free of
+    /// zero padding this far inside a crop. The U-Net then sees far wider (thesis: 135 px).
+    pub fn feature_radius(&self) -> usize {
+        2 * self.feature_blocks + 1
+    }
+
+    fn validate(&self, patch: usize) -> Result<()> {
+        let widths = [self.feature_width, self.unet_width];
+        if widths.iter().any(|&w| w == 0 || w > MAX_EPISHIFT_WIDTH) {
+            bail!("epishift.feature_width and unet_width must be 1 to {MAX_EPISHIFT_WIDTH}");
+        }
+        if self.feature_blocks > 64 || self.unet_depth > 8 {
+            bail!("epishift.feature_blocks must be at most 64 and unet_depth at most 8");
+        }
+        if self.unet_width << self.unet_depth > MAX_EPISHIFT_WIDTH {
+            bail!(
+                "epishift: unet_width {} doubled {} times is over {MAX_EPISHIFT_WIDTH} channels",
+                self.unet_width,
+                self.unet_depth
+            );
+        }
+        if !patch.is_multiple_of(1 << self.unet_depth) {
+            bail!(
+                "patch {patch} must be a multiple of 2^unet_depth = {} (the U-Net halves it \
+                 unet_depth times)",
+                1 << self.unet_depth
+            );
+        }
+        if self.train_shifts.is_multiple_of(2) || self.train_shifts > 63 {
+            bail!("epishift.train_shifts must be odd and at most 63");
+        }
+        let eps_ok = |e: f32| (0.0..=1.5).contains(&e);
+        if !(eps_ok(self.epsilon) && eps_ok(self.reg_epsilon)) {
+            bail!("epishift.epsilon and reg_epsilon must lie in [0, 1.5]");
+        }
+        if !(self.alpha.is_finite() && self.alpha >= 0.0) {
+            bail!("epishift.alpha must be finite and ≥ 0");
+        }
+        if !(0.0..=1.0).contains(&self.refine_threshold)
+            || self.median_window.is_multiple_of(2)
+            || self.median_window > 63
+        {
+            bail!("epishift.refine_threshold must lie in [0, 1], median_window be odd and ≤ 63");
+        }
+        if let Some([lo, hi]) = self.range {
+            if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
+                bail!("epishift.range must be an increasing [min, max]");
+            }
+            if Self::shifts_for(lo, hi).len() > MAX_SHIFTS {
+                bail!("epishift.range asks for over {MAX_SHIFTS} shifts");
+            }
+        }
+        Ok(())
     }
 }
 
@@ -283,6 +448,8 @@ pub struct TrainConfig {
     pub ese: EseConfig,
     /// DPP settings.
     pub dpp: DppConfig,
+    /// EPI-Shift settings.
+    pub epishift: EpiShiftConfig,
 }
 
 impl Default for TrainConfig {
@@ -315,6 +482,7 @@ impl Default for TrainConfig {
             augment: AugmentConfig::default(),
             ese: EseConfig::default(),
             dpp: DppConfig::default(),
+            epishift: EpiShiftConfig::default(),
         }
     }
 }
@@ -420,6 +588,12 @@ impl TrainConfig {
         if !(0.0..1.0).contains(&self.texture_threshold) || self.texture_window.is_multiple_of(2) {
             bail!("texture_threshold must lie in [0, 1) and texture_window be odd");
         }
+        if self.model == ModelKind::EpiShift {
+            if self.multimodal {
+                bail!("epishift trains on one disparity per pixel: set multimodal = false");
+            }
+            self.epishift.validate(self.patch)?;
+        }
         Ok(())
     }
 
@@ -443,8 +617,10 @@ impl TrainConfig {
 
     /// Pixels at each crop edge that get no loss.
     pub fn loss_border(&self) -> usize {
-        self.loss_border
-            .unwrap_or_else(|| self.net.receptive_radius())
+        self.loss_border.unwrap_or_else(|| match self.model {
+            ModelKind::EpiShift => self.epishift.feature_radius(),
+            _ => self.net.receptive_radius(),
+        })
     }
 
     /// Whether batch norm is frozen for the step that follows `done` finished steps.
@@ -546,6 +722,65 @@ mod tests {
         let mut cfg = TrainConfig::default();
         cfg.ese.range = Some([-1e6, 1e6]);
         assert!(cfg.validate().unwrap_err().to_string().contains("passes"));
+    }
+
+    #[test]
+    fn ese_passes_can_span_each_scenes_range() {
+        let wide = Some([-40.1, 40.1]);
+        let ese = EseConfig::default();
+        assert_eq!(ese.scene_shifts(wide).len(), 7, "off by default");
+        let on = EseConfig {
+            scene_range: true,
+            ..ese
+        };
+        let s = on.scene_shifts(wide);
+        assert_eq!((s.len(), s[0]), (81, -40.1));
+        assert!((s[80] - 39.9).abs() < 1e-3, "{}", s[80]);
+        assert_eq!(on.scene_shifts(None).len(), 7);
+        let fixed = EseConfig {
+            range: Some([-1.0, 1.0]),
+            ..on
+        };
+        assert_eq!(fixed.scene_shifts(wide), vec![-1.0, 0.0]);
+    }
+
+    #[test]
+    fn epishift_defaults_are_the_thesis_and_the_cpu_recipe_parses() {
+        let cfg = TrainConfig {
+            model: ModelKind::EpiShift,
+            ..TrainConfig::default()
+        };
+        cfg.validate().unwrap();
+        let e = &cfg.epishift;
+        assert_eq!(
+            (
+                e.feature_width,
+                e.feature_blocks,
+                e.unet_width,
+                e.unet_depth
+            ),
+            (64, 4, 64, 5)
+        );
+        assert_eq!(
+            (e.epsilon, e.alpha, e.class_target),
+            (0.17, 2.5, ClassTarget::Rectangle)
+        );
+        assert_eq!(e.train_offsets(), vec![-3, -2, -1, 0, 1, 2, 3]);
+        assert_eq!(cfg.loss_border(), 9);
+        let recipe: TrainConfig =
+            toml::from_str(include_str!("../configs/epishift_cpu.toml")).unwrap();
+        recipe.validate().unwrap();
+        assert_eq!(recipe.model, ModelKind::EpiShift);
+        let bad = |f: fn(&mut TrainConfig)| {
+            let mut c = cfg.clone();
+            f(&mut c);
+            c.validate().unwrap_err().to_string()
+        };
+        assert!(bad(|c| c.patch = 100).contains("2^unet_depth"));
+        assert!(bad(|c| c.multimodal = true).contains("multimodal"));
+        assert!(bad(|c| c.epishift.train_shifts = 4).contains("odd"));
+        assert!(bad(|c| c.epishift.range = Some([-1e6, 1e6])).contains("shifts"));
+        assert!(bad(|c| c.epishift.unet_depth = 8).contains("channels"));
     }
 
     #[test]

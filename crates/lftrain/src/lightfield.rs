@@ -24,6 +24,9 @@ pub struct LightField {
     pub height: usize,
     /// `n * n` entries, index `v * n + u`; `None` off the star.
     pub views: Vec<Option<Vec<f32>>>,
+    /// The scene's disparity range `[disp_min, disp_max]` from `parameters.cfg` (EPI-Shift's
+    /// inference shifts cover it); `None` for light fields built in memory.
+    pub disparity_range: Option<[f32; 2]>,
 }
 
 impl LightField {
@@ -46,11 +49,14 @@ impl LightField {
             let path = dir.join(format!("input_Cam{:03}.png", v * nx + u));
             views[v * nx + u] = Some(read_rgb(&path, width, height)?);
         }
+        let range = [params.disp_min as f32, params.disp_max as f32];
         Ok(Self {
             n: nx,
             width,
             height,
             views,
+            disparity_range: (range.iter().all(|d| d.is_finite()) && range[0] <= range[1])
+                .then_some(range),
         })
     }
 
@@ -77,6 +83,7 @@ impl LightField {
             width,
             height,
             views,
+            disparity_range: None,
         }
     }
 
@@ -108,11 +115,13 @@ impl LightField {
                     .map(|rgb| crop_plane(rgb, sw, sh, 3, (x0, y0), (w, h), step))
             })
             .collect();
+        let k = step.max(1) as f32;
         Self {
             n: self.n,
             width: w,
             height: h,
             views,
+            disparity_range: self.disparity_range.map(|[lo, hi]| [lo / k, hi / k]),
         }
     }
 
@@ -138,6 +147,7 @@ impl LightField {
             width: self.height,
             height: self.width,
             views,
+            disparity_range: self.disparity_range,
         }
     }
 

@@ -15,9 +15,29 @@ use rand::RngExt;
 use rand_pcg::Pcg32;
 use rayon::prelude::*;
 
-use crate::config::TrainConfig;
+use crate::config::{ModelKind, TrainConfig};
 use crate::sample::{Batch, Draw, make_sample};
 use crate::scene::{Scene, Unimodal};
+use crate::shift_sample::{ShiftBatch, make_shift_sample};
+
+/// A batch of either kind of network input.
+#[derive(Clone, Debug, PartialEq)]
+pub enum TrainBatch {
+    /// The four stacks (BASE, UPR, ESE, DPP).
+    Stacks(Batch),
+    /// Integer-shifted cross stacks (EPI-Shift).
+    Shifts(ShiftBatch),
+}
+
+impl TrainBatch {
+    /// Crops in the batch.
+    pub fn size(&self) -> usize {
+        match self {
+            TrainBatch::Stacks(b) => b.size,
+            TrainBatch::Shifts(b) => b.size,
+        }
+    }
+}
 
 /// Pool and refresh sizes of the loader.
 #[derive(Clone, Copy, Debug)]
@@ -30,7 +50,7 @@ pub struct PoolConfig {
 
 /// The receiving end of the background loader; dropping it stops the thread.
 pub struct Loader {
-    rx: Receiver<Result<Batch>>,
+    rx: Receiver<Result<TrainBatch>>,
     handle: Option<JoinHandle<()>>,
 }
 
@@ -58,7 +78,7 @@ impl Loader {
     }
 
     /// The next batch (blocks until ready).
-    pub fn next_batch(&self) -> Result<Batch> {
+    pub fn next_batch(&self) -> Result<TrainBatch> {
         self.rx
             .recv()
             .context("the loader thread stopped unexpectedly")?
@@ -96,7 +116,7 @@ fn run(
     cfg: TrainConfig,
     pool_cfg: PoolConfig,
     stream: u64,
-    tx: SyncSender<Result<Batch>>,
+    tx: SyncSender<Result<TrainBatch>>,
 ) {
     let mut rng = Pcg32::new(cfg.seed, stream);
     let load = |d: &SceneDir| {
@@ -129,17 +149,31 @@ fn run(
             }
         }
         let seeds: Vec<u64> = (0..cfg.batch).map(|_| rng.random()).collect();
-        let samples = seeds
-            .into_par_iter()
+        let draws: Vec<(&Scene, Draw)> = seeds
+            .into_iter()
             .map(|seed| {
                 let mut r = Pcg32::new(seed, stream);
                 let scene = &pool[r.random_range(0..pool.len())];
                 let size = (scene.lf.width, scene.lf.height);
                 let draw = Draw::random(&cfg.augment, cfg.patch, cfg.crop_margin, size, &mut r);
-                make_sample(scene, &draw, cfg.patch, cfg.loss_border())
+                (scene, draw)
             })
             .collect();
-        let batch = Batch::from_samples(samples, cfg.patch, cfg.target_modes());
+        let (patch, border) = (cfg.patch, cfg.loss_border());
+        let batch = if cfg.model == ModelKind::EpiShift {
+            let offsets = cfg.epishift.train_offsets();
+            let samples = draws
+                .into_par_iter()
+                .map(|(scene, draw)| make_shift_sample(scene, &draw, patch, border, &offsets))
+                .collect();
+            TrainBatch::Shifts(ShiftBatch::from_samples(samples, patch, offsets.len()))
+        } else {
+            let samples = draws
+                .into_par_iter()
+                .map(|(scene, draw)| make_sample(scene, &draw, patch, border))
+                .collect();
+            TrainBatch::Stacks(Batch::from_samples(samples, patch, cfg.target_modes()))
+        };
         if tx.send(Ok(batch)).is_err() {
             return;
         }

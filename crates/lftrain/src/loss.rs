@@ -38,6 +38,7 @@ pub fn loss(cfg: &TrainConfig, out: Tensor<4>, t: &TargetTensors) -> Tensor<1> {
             laplace_nll(out, t, t.eta.clone() * inside.float())
         }
         ModelKind::Dpp => cross_entropy(out, t),
+        ModelKind::EpiShift => unreachable!("EPI-Shift's loss is crate::shift_loss"),
     }
 }
 

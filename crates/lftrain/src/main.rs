@@ -7,13 +7,13 @@ use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
 use lftrain::config::{ModelKind, TrainConfig};
 use lftrain::loader::PoolConfig;
-use lftrain::predict::predict_dataset;
+use lftrain::predict::predict_dataset_over;
 use lftrain::train::{TrainArgs, bench_loader, bench_steps, train};
 
 #[derive(Parser)]
 #[command(
     version,
-    about = "Train light-field depth posterior models (BASE, UPR, ESE, DPP)"
+    about = "Train light-field depth models (BASE, UPR, ESE, DPP, EPI-Shift)"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -39,6 +39,10 @@ enum Command {
         /// Output folder (one lfeval method).
         #[arg(long)]
         out: PathBuf,
+        /// Disparity range MIN,MAX the shifts cover (epishift: default each scene's
+        /// parameters.cfg; ese: default its config's passes).
+        #[arg(long, value_name = "MIN,MAX", allow_hyphen_values = true, value_parser = parse_range)]
+        range: Option<[f32; 2]>,
     },
     /// Seconds per training step of a configuration on random input (no data loading), or
     /// with --loader the crops/s of the data loader alone.
@@ -195,10 +199,27 @@ fn run(cli: Cli) -> Result<()> {
                 cfg.batch as f64 / s
             );
         }
-        Command::Predict { run, dataset, out } => {
-            let n = predict_dataset(&run, &dataset, &out, cli.quiet)?;
+        Command::Predict {
+            run,
+            dataset,
+            out,
+            range,
+        } => {
+            let n = predict_dataset_over(&run, &dataset, &out, cli.quiet, range)?;
             eprintln!("lftrain: {n} scenes written to {}", out.display());
         }
     }
     Ok(())
+}
+
+/// `MIN,MAX` in pixels, MIN ≤ MAX.
+fn parse_range(s: &str) -> std::result::Result<[f32; 2], String> {
+    let bad = || format!("expected MIN,MAX such as -40,40, got {s:?}");
+    let (lo, hi) = s.split_once(',').ok_or_else(bad)?;
+    let num = |v: &str| v.trim().parse::<f32>().map_err(|_| bad());
+    let r = [num(lo)?, num(hi)?];
+    if !(r[0].is_finite() && r[1].is_finite() && r[0] <= r[1]) {
+        return Err(bad());
+    }
+    Ok(r)
 }

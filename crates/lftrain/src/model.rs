@@ -8,6 +8,7 @@ use burn::prelude::*;
 use burn::tensor::activation::relu;
 
 use crate::config::NetConfig;
+use crate::epishift::EpiShiftNet;
 
 /// A 2×2 convolution; `grow` pads by one on every side (size + 1), otherwise none (size − 1):
 /// the thesis alternates the two so that every block keeps the image size.
@@ -139,5 +140,27 @@ impl EpiNet {
         ];
         let x = chain(&self.head, Tensor::cat(features, 1));
         self.last_second.forward(relu(self.last_first.forward(x)))
+    }
+}
+
+/// The network of a run: EPINET's for BASE, UPR, ESE and DPP, EPI-Shift's for EPI-Shift.
+// One network per run, moved rarely: the size difference does not matter, and burn's Module
+// derive does not see through a Box.
+#[allow(clippy::large_enum_variant)]
+#[derive(Module, Debug)]
+pub enum Network {
+    /// Appendix B.1.
+    Epi(EpiNet),
+    /// Thesis §4.2.3.
+    Shift(EpiShiftNet),
+}
+
+impl Network {
+    /// The network with every batch norm frozen.
+    pub fn freeze_batch_norm(self) -> Self {
+        match self {
+            Network::Epi(n) => Network::Epi(n.freeze_batch_norm()),
+            Network::Shift(n) => Network::Shift(n.freeze_batch_norm()),
+        }
     }
 }

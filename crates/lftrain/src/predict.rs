@@ -1,5 +1,6 @@
 //! Inference on whole scenes, turned into lfeval's prediction formats: BASE a disparity map,
-//! UPR a Laplace posterior, ESE a mixture of the M shifted passes, DPP a discrete posterior.
+//! UPR a Laplace posterior, ESE a mixture of the M shifted passes, DPP a discrete posterior,
+//! EPI-Shift a disparity map with `1 − max_s C^s` as its uncertainty.
 
 use std::time::Instant;
 
@@ -10,8 +11,10 @@ use lfeval::prediction::{ScenePrediction, point_estimates};
 use lfformat::pfm::FloatImage;
 
 use crate::config::{ModelKind, TrainConfig};
+use crate::epishift::EpiShiftNet;
 use crate::lightfield::LightField;
-use crate::model::EpiNet;
+use crate::model::{EpiNet, Network};
+use crate::shift_predict::{decide, run_shifts, scene_shifts};
 use crate::stacks::{Direction, Region, extract};
 use crate::tensors::{tensor4, values};
 
@@ -32,6 +35,42 @@ pub fn run_net(net: &EpiNet, lf: &LightField, shift: f32, device: &Device) -> Ve
 /// The prediction of `net` (trained as `cfg.model`) for `lf`, with its runtime.
 pub fn predict(
     cfg: &TrainConfig,
+    net: &Network,
+    lf: &LightField,
+    device: &Device,
+) -> ScenePrediction {
+    match net {
+        Network::Epi(n) => predict_epinet(cfg, n, lf, device),
+        Network::Shift(n) => predict_epishift(cfg, n, lf, device),
+    }
+}
+
+/// EPI-Shift over the shifts covering `lf`'s range (`cfg.epishift.range` or the scene's
+/// `parameters.cfg`): the disparity `D` (eq. 4.11 refined) and `1 − max_s C^s` as the
+/// uncertainty lfeval's sparsification ranks by (the thesis gives no confidence; a pixel
+/// whose best shift is barely classified is the least trustworthy).
+pub fn predict_epishift(
+    cfg: &TrainConfig,
+    net: &EpiShiftNet,
+    lf: &LightField,
+    device: &Device,
+) -> ScenePrediction {
+    let start = Instant::now();
+    let shifts = scene_shifts(&cfg.epishift, lf);
+    let maps = run_shifts(net, lf, &shifts, cfg.epishift.unet_depth, device);
+    let est = decide(&maps, &cfg.epishift);
+    let (w, h) = (lf.width, lf.height);
+    let uncertainty = est.confidence.iter().map(|c| 1.0 - c).collect();
+    ScenePrediction {
+        disparity: FloatImage::new(w, h, est.disparity),
+        uncertainty: Some(FloatImage::new(w, h, uncertainty)),
+        posterior: None,
+        runtime_s: Some(start.elapsed().as_secs_f64()),
+    }
+}
+
+fn predict_epinet(
+    cfg: &TrainConfig,
     net: &EpiNet,
     lf: &LightField,
     device: &Device,
@@ -48,6 +87,7 @@ pub fn predict(
         }
         ModelKind::Ese => Some(ese_mixture(cfg, net, lf, device)),
         ModelKind::Dpp => Some(dpp_posterior(cfg, run_net(net, lf, 0.0, device))),
+        ModelKind::EpiShift => unreachable!("EPI-Shift runs its own network"),
     };
     let (disparity, posterior) = match posterior {
         None => {
@@ -74,7 +114,7 @@ pub fn predict(
 /// The ESE mixture (thesis eq. 5.9): pass `k` on the light field shifted by `s_k` predicts
 /// `d - s_k`, so its Laplacian is centred at `μ_k + s_k`; all passes weigh `1/M`.
 fn ese_mixture(cfg: &TrainConfig, net: &EpiNet, lf: &LightField, device: &Device) -> PosteriorForm {
-    let shifts = cfg.ese.shifts();
+    let shifts = cfg.ese.scene_shifts(lf.disparity_range);
     let m = shifts.len();
     let pixels = lf.width * lf.height;
     let (mut mu, mut log_b) = (vec![0.0; pixels * m], vec![0.0; pixels * m]);
@@ -123,8 +163,33 @@ pub fn predict_dataset(
     out: &std::path::Path,
     quiet: bool,
 ) -> anyhow::Result<usize> {
+    predict_dataset_over(run, dataset, out, quiet, None)
+}
+
+/// [`predict_dataset`] with the disparity range of the shifts given (`--range`): EPI-Shift's
+/// integer shifts, or ESE's passes at its step, then cover `range` instead of what the run's
+/// config (EPI-Shift: each scene's `parameters.cfg`) says.
+pub fn predict_dataset_over(
+    run: &std::path::Path,
+    dataset: &std::path::Path,
+    out: &std::path::Path,
+    quiet: bool,
+    range: Option<[f32; 2]>,
+) -> anyhow::Result<usize> {
     let run = crate::run::RunDir::new(run);
-    let cfg = run.config()?;
+    let mut cfg = run.config()?;
+    if let Some(r) = range {
+        match cfg.model {
+            ModelKind::EpiShift => cfg.epishift.range = Some(r),
+            ModelKind::Ese => cfg.ese.range = Some(r),
+            m => anyhow::bail!(
+                "--range applies to epishift and ese runs, this is {}",
+                m.name()
+            ),
+        }
+        cfg.validate()
+            .map_err(|e| e.context(format!("--range {},{}", r[0], r[1])))?;
+    }
     let state = run.state()?;
     let device = crate::train::default_device();
     let net = run.load_net(&cfg, state.grid, &device)?.valid();

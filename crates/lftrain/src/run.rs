@@ -9,8 +9,9 @@ use lfeval::dataset::{PARAMETERS_FILE, SceneDir};
 use lfformat::HciParameters;
 use serde::{Deserialize, Serialize};
 
-use crate::config::TrainConfig;
-use crate::model::EpiNet;
+use crate::config::{ModelKind, TrainConfig};
+use crate::epishift::EpiShiftNet;
+use crate::model::{EpiNet, Network};
 
 /// The config of a run, as written at its start.
 pub const CONFIG_FILE: &str = "config.toml";
@@ -74,14 +75,17 @@ impl RunDir {
 
     /// Writes the weights, the optimiser state and `state`; the state file last, so that an
     /// interrupted write never leaves a state pointing at missing weights.
-    pub fn save(&self, net: &EpiNet, optim: &ModuleOptimizer, state: &RunState) -> Result<()> {
+    pub fn save(&self, net: &Network, optim: &ModuleOptimizer, state: &RunState) -> Result<()> {
         let dir = self.dir.join(CHECKPOINT_DIR);
         std::fs::create_dir_all(&dir)
             .with_context(|| format!("{}: cannot create", dir.display()))?;
         let path = self.checkpoint(MODEL_FILE);
-        net.clone()
-            .save_file(&path)
-            .map_err(|e| anyhow::anyhow!("{}: cannot write: {e:?}", path.display()))?;
+        // The inner network is stored, so that checkpoints of EPINET runs keep their layout.
+        match net.clone() {
+            Network::Epi(n) => n.save_file(&path),
+            Network::Shift(n) => n.save_file(&path),
+        }
+        .map_err(|e| anyhow::anyhow!("{}: cannot write: {e:?}", path.display()))?;
         let path = self.checkpoint(OPTIMIZER_FILE);
         optim
             .save(&path)
@@ -92,11 +96,13 @@ impl RunDir {
     }
 
     /// The network of this run with the checkpoint's weights, on `device`.
-    pub fn load_net(&self, cfg: &TrainConfig, grid: usize, device: &Device) -> Result<EpiNet> {
+    pub fn load_net(&self, cfg: &TrainConfig, grid: usize, device: &Device) -> Result<Network> {
         let path = self.checkpoint(MODEL_FILE);
-        build_net(cfg, grid, device)
-            .try_load_file(&path)
-            .map_err(|e| anyhow::anyhow!("{}: cannot load weights: {e:?}", path.display()))
+        let err = |e| anyhow::anyhow!("{}: cannot load weights: {e:?}", path.display());
+        Ok(match build_net(cfg, grid, device) {
+            Network::Epi(n) => Network::Epi(n.try_load_file(&path).map_err(err)?),
+            Network::Shift(n) => Network::Shift(n.try_load_file(&path).map_err(err)?),
+        })
     }
 
     /// The optimiser state of the checkpoint.
@@ -109,13 +115,16 @@ impl RunDir {
 }
 
 /// A fresh network for `cfg` and an `grid × grid` camera grid.
-pub fn build_net(cfg: &TrainConfig, grid: usize, device: &Device) -> EpiNet {
-    EpiNet::new(
-        &cfg.net,
-        grid * 3,
-        cfg.model.out_channels(cfg.dpp.bins),
-        device,
-    )
+pub fn build_net(cfg: &TrainConfig, grid: usize, device: &Device) -> Network {
+    match cfg.model {
+        ModelKind::EpiShift => Network::Shift(EpiShiftNet::new(&cfg.epishift, grid * 3, device)),
+        _ => Network::Epi(EpiNet::new(
+            &cfg.net,
+            grid * 3,
+            cfg.model.out_channels(cfg.dpp.bins),
+            device,
+        )),
+    }
 }
 
 /// The camera grid side shared by all `scenes` (an error if they differ or are not square).

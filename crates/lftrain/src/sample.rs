@@ -132,7 +132,7 @@ pub fn make_sample(scene: &Scene, draw: &Draw, patch: usize, border: usize) -> S
 }
 
 /// 1 where the crop's pixels get a loss, 0 elsewhere (`patch²`, in the rotated frame).
-fn loss_region(
+pub(crate) fn loss_region(
     scene: &Scene,
     origin: (isize, isize),
     patch: usize,
@@ -153,7 +153,7 @@ fn loss_region(
 }
 
 /// The targets of the crop, rotated, shifted by `-shift` and split into planes.
-fn target_planes(
+pub(crate) fn target_planes(
     t: &Targets,
     origin: (isize, isize),
     patch: usize,

@@ -150,7 +150,8 @@ impl TwoPlanes {
     pub fn write(&self, dir: &Path, multimodal: bool) -> Result<()> {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("{}: cannot create", dir.display()))?;
-        parameters(self.n, self.size).write(&dir.join("parameters.cfg"))?;
+        let (lo, hi) = (self.back.min(self.front), self.back.max(self.front));
+        parameters(self.n, self.size, [lo, hi]).write(&dir.join("parameters.cfg"))?;
         let lf = self.render();
         for (i, view) in lf.views.iter().enumerate() {
             let Some(rgb) = view else { continue };
@@ -172,8 +173,9 @@ impl TwoPlanes {
     }
 }
 
-/// HCI parameters of an `n × n` grid of `size²` images (only the grid and size matter here).
-fn parameters(n: usize, size: usize) -> HciParameters {
+/// HCI parameters of an `n × n` grid of `size²` images whose disparities span `range` (only
+/// the grid, the size and the range matter here; the range is widened as HCI writes it).
+fn parameters(n: usize, size: usize, [lo, hi]: [f32; 2]) -> HciParameters {
     HciParameters {
         focal_length_mm: 100.0,
         image_resolution_x_px: size as u32,
@@ -195,8 +197,8 @@ fn parameters(n: usize, size: usize) -> HciParameters {
         date: "2026-01-01".into(),
         version: "synthetic".into(),
         cycles_seed: 0,
-        disp_min: -1.1,
-        disp_max: 1.4,
+        disp_min: (lo as f64 * 10.0).floor() / 10.0 - 0.1,
+        disp_max: (hi as f64 * 10.0).ceil() / 10.0 + 0.1,
         frustum_disp_min: -2.0,
         frustum_disp_max: 2.0,
         depth_map_scale: 1.0,

@@ -4,8 +4,10 @@ use burn::prelude::*;
 use burn::tensor::TensorData;
 
 use crate::config::{ModelKind, TrainConfig};
+use crate::epishift::ShiftInput;
 use crate::loss::{TargetTensors, dpp_bin};
 use crate::sample::Batch;
+use crate::shift_sample::ShiftBatch;
 
 /// A `[b, c, h, w]` float tensor from row-major values.
 pub fn tensor4(values: Vec<f32>, shape: [usize; 4], device: &Device) -> Tensor<4> {
@@ -19,6 +21,17 @@ pub fn stack_tensors(batch: &Batch, device: &Device) -> [Tensor<4>; 4] {
         .stacks
         .clone()
         .map(|values| tensor4(values, shape, device))
+}
+
+/// The network input of an EPI-Shift batch.
+pub fn shift_input(batch: &ShiftBatch, device: &Device) -> ShiftInput {
+    let (b, p) = (batch.size, batch.patch);
+    let stacks = [b * (batch.shifts + 2), batch.stack_channels, p, p];
+    ShiftInput {
+        horizontal: tensor4(batch.horizontal.clone(), stacks, device),
+        vertical: tensor4(batch.vertical.clone(), stacks, device),
+        centre: tensor4(batch.centre.clone(), [b, 3, p, p], device),
+    }
 }
 
 /// The targets of `batch`, with DPP bin indices when `cfg.model` is DPP.

@@ -10,13 +10,15 @@ use burn::prelude::*;
 use indicatif::{ProgressBar, ProgressStyle};
 use lfeval::dataset::discover;
 
-use crate::config::TrainConfig;
-use crate::loader::{Loader, PoolConfig};
+use crate::config::{ModelKind, TrainConfig};
+use crate::loader::{Loader, PoolConfig, TrainBatch};
 use crate::log::{Record, TrainLog};
 use crate::loss::loss;
-use crate::model::EpiNet;
+use crate::model::Network;
 use crate::run::{CONFIG_FILE, RunDir, RunState, build_net, grid_of};
-use crate::tensors::{stack_tensors, target_tensors};
+use crate::shift_loss::{ShiftTargets, epishift_loss};
+use crate::shift_sample::ShiftBatch;
+use crate::tensors::{shift_input, stack_tensors, target_tensors};
 use crate::validate::{ValScene, ValScores, load_scenes, validate};
 
 /// What `lftrain train` was asked to do.
@@ -114,7 +116,7 @@ pub fn train(mut cfg: TrainConfig, args: &TrainArgs) -> Result<TrainSummary> {
 /// The mutable state of a training run.
 struct Trainer {
     cfg: TrainConfig,
-    net: EpiNet,
+    net: Network,
     optim: ModuleOptimizer,
     device: Device,
     base: Device,
@@ -159,7 +161,7 @@ impl Trainer {
             let mut record = Record {
                 step,
                 loss,
-                samples_per_s: batch.size as f64 / dt,
+                samples_per_s: batch.size() as f64 / dt,
                 elapsed_s: self.state.elapsed_s,
                 ..Record::default()
             };
@@ -195,12 +197,26 @@ impl Trainer {
         })
     }
 
+    /// The loss of `batch` (scalar tensor with its graph).
+    fn loss(&self, batch: &TrainBatch) -> Result<Tensor<1>> {
+        Ok(match (&self.net, batch) {
+            (Network::Epi(net), TrainBatch::Stacks(b)) => {
+                let out = net.forward(stack_tensors(b, &self.device));
+                loss(&self.cfg, out, &target_tensors(b, &self.cfg, &self.device))
+            }
+            (Network::Shift(net), TrainBatch::Shifts(b)) => {
+                let (class, reg) = net.forward(shift_input(b, &self.device));
+                let offsets = self.cfg.epishift.train_offsets();
+                let targets = ShiftTargets::of(b, &offsets, &self.device);
+                epishift_loss(&self.cfg.epishift, class, reg, &targets)
+            }
+            _ => bail!("internal error: the batch does not fit the network"),
+        })
+    }
+
     /// One Adam step on `batch`; returns its loss.
-    fn step(&mut self, batch: &crate::sample::Batch) -> Result<f64> {
-        let stacks = stack_tensors(batch, &self.device);
-        let targets = target_tensors(batch, &self.cfg, &self.device);
-        let out = self.net.forward(stacks);
-        let loss = loss(&self.cfg, out, &targets);
+    fn step(&mut self, batch: &TrainBatch) -> Result<f64> {
+        let loss = self.loss(batch)?;
         let value = loss.clone().into_scalar::<f32>() as f64;
         if !value.is_finite() {
             bail!("step {}: the loss is {value}", self.state.step + 1);
@@ -259,15 +275,32 @@ pub fn bench_steps(cfg: &TrainConfig, grid: usize, steps: usize) -> Result<(f64,
             .collect()
     };
     let plane = b * p * p;
-    let batch = crate::sample::Batch {
-        size: b,
-        patch: p,
-        stack_channels: grid * 3,
-        modes,
-        stacks: std::array::from_fn(|_| noise(plane * grid * 3, 1.0)),
-        disparity: noise(plane * modes, 6.0),
-        eta: vec![1.0 / modes as f32; plane * modes],
-        loss_pixels: plane,
+    let batch = if cfg.model == ModelKind::EpiShift {
+        let s = cfg.epishift.train_shifts;
+        TrainBatch::Shifts(ShiftBatch {
+            size: b,
+            patch: p,
+            stack_channels: grid * 3,
+            shifts: s,
+            horizontal: noise(plane * (s + 2) * grid * 3, 1.0),
+            vertical: noise(plane * (s + 2) * grid * 3, 1.0),
+            centre: noise(plane * 3, 1.0),
+            disparity: noise(plane, 6.0),
+            weight: vec![1.0; plane],
+            clip: vec![1.0; plane * s],
+            loss_pixels: plane,
+        })
+    } else {
+        TrainBatch::Stacks(crate::sample::Batch {
+            size: b,
+            patch: p,
+            stack_channels: grid * 3,
+            modes,
+            stacks: std::array::from_fn(|_| noise(plane * grid * 3, 1.0)),
+            disparity: noise(plane * modes, 6.0),
+            eta: vec![1.0 / modes as f32; plane * modes],
+            loss_pixels: plane,
+        })
     };
     let mut trainer = Trainer {
         cfg: cfg.clone(),
@@ -305,7 +338,7 @@ pub fn bench_loader(
     let t0 = Instant::now();
     let mut crops = 0;
     for _ in 0..batches {
-        crops += loader.next_batch()?.size;
+        crops += loader.next_batch()?.size();
     }
     Ok((first, crops as f64 / t0.elapsed().as_secs_f64()))
 }

@@ -13,7 +13,7 @@ use serde::Serialize;
 
 use crate::config::TrainConfig;
 use crate::lightfield::LightField;
-use crate::model::EpiNet;
+use crate::model::Network;
 use crate::predict::predict;
 
 /// A validation scene, loaded once.
@@ -61,7 +61,7 @@ pub fn eval_config(cfg: &TrainConfig) -> EvalConfig {
 /// Scores of `net` (validation mode, plain device) on `scenes`.
 pub fn validate(
     cfg: &TrainConfig,
-    net: &EpiNet,
+    net: &Network,
     scenes: &[ValScene],
     device: &Device,
 ) -> ValScores {

@@ -309,7 +309,12 @@ fn every_model_writes_a_posterior_lfeval_reads() {
             net: tiny_net(),
             ..TrainConfig::default()
         };
-        let net = EpiNet::new(&c.net, 9, model.out_channels(c.dpp.bins), &dev);
+        let net = lftrain::model::Network::Epi(EpiNet::new(
+            &c.net,
+            9,
+            model.out_channels(c.dpp.bins),
+            &dev,
+        ));
         let pred = lftrain::predict::predict(&c, &net, &lf, &dev);
         let dir = tmp.path().join(model.name());
         lfeval::prediction::write_prediction(&dir, "s", &pred).unwrap();
