@@ -57,12 +57,17 @@ impl RayKey {
     }
 }
 
-/// A pixel's sampler: sample `index`, next dimension `dim`.
+/// A pixel's sampler: sample `index`, next dimension `dim`, and the 4-D set of values that
+/// `dim` falls in (computed once per set: `sobol_burley` evaluates four dimensions at the cost
+/// of one).
 pub struct Sampler {
     seed: u64,
     index: u32,
     dim: u32,
     strata: [u32; 2],
+    /// Which set `values` holds (`u32::MAX`: none).
+    set: u32,
+    values: [f32; 4],
 }
 
 impl Sampler {
@@ -70,29 +75,30 @@ impl Sampler {
     pub fn new(seed: u64, scene: u64, view: u32, x: u32, y: u32, spp: u32) -> Self {
         let key = mix64(mix64(mix64(seed) ^ scene) ^ view as u64);
         let pixel = (y as u64) << 32 | x as u64;
-        Self {
-            seed: mix64(key ^ pixel),
-            index: 0,
-            dim: 0,
-            strata: strata(spp),
-        }
+        Self::with_seed(mix64(key ^ pixel), strata(spp))
     }
 
     /// An independent sequence keyed by a 64-bit value (side computations that must not shift
     /// the pixel's own values, such as shading hidden slice surfaces).
     pub fn from_key(key: u64) -> Self {
+        Self::with_seed(mix64(!key), [1, 1])
+    }
+
+    fn with_seed(seed: u64, strata: [u32; 2]) -> Self {
         Self {
-            seed: mix64(!key),
+            seed,
             index: 0,
             dim: 0,
-            strata: [1, 1],
+            strata,
+            set: u32::MAX,
+            values: [0.0; 4],
         }
     }
 
     /// Starts sample `index` of the pixel at its first dimension.
     #[inline]
     pub fn start_sample(&mut self, index: u32) {
-        (self.index, self.dim) = (index, 0);
+        (self.index, self.dim, self.set) = (index, 0, u32::MAX);
     }
 
     /// Moves to the dimensions of path vertex `depth` (after the camera ray's).
@@ -105,8 +111,12 @@ impl Sampler {
     pub fn next_f32(&mut self) -> f32 {
         let (set, within) = (self.dim / 4, self.dim % 4);
         self.dim += 1;
-        let scramble = mix64(self.seed ^ (set as u64) << 32 ^ (self.index / SEQUENCE) as u64);
-        sobol_burley::sample(self.index % SEQUENCE, within, scramble as u32)
+        if set != self.set {
+            let scramble = mix64(self.seed ^ (set as u64) << 32 ^ (self.index / SEQUENCE) as u64);
+            self.values = sobol_burley::sample_4d(self.index % SEQUENCE, 0, scramble as u32);
+            self.set = set;
+        }
+        self.values[within as usize]
     }
 
     #[inline]
