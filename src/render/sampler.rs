@@ -50,6 +50,13 @@ pub struct RayKey {
 }
 
 impl RayKey {
+    /// A 64-bit value distinct per camera sample (the hash is the pixel's, the phase the
+    /// sample's): the key of side streams such as hidden slice surfaces' shading.
+    #[inline]
+    pub fn stream(self) -> u64 {
+        self.hash ^ (self.phase.to_bits() as u64) << 32
+    }
+
     /// The uniform number that surface `id` is tested with.
     #[inline]
     pub fn uniform(self, id: u32) -> f32 {

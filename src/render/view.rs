@@ -348,7 +348,7 @@ impl PixelCtx<'_> {
                     origin,
                     dir,
                     Some(*h),
-                    &mut Sampler::from_key(key.hash ^ i as u64),
+                    &mut Sampler::from_key(key.stream() ^ i as u64),
                 )),
                 false => None,
             };
