@@ -168,6 +168,31 @@ pub struct EseConfig {
     /// fixed ±3 does not reach. Scenes without a range keep `members`.
     #[serde(default)]
     pub scene_range: bool,
+    /// What the training loss does with pixels outside `|d| < Δd/2` (see [`EseOutside`]).
+    #[serde(default)]
+    pub outside: EseOutside,
+    /// With `outside = "uncertain"`: `log b` above this earns nothing more (mmlf: no cap, so
+    /// out-of-range `log b` grows without end). 5 is b ≈ 148 px, past any range.
+    #[serde(default = "default_max_log_b")]
+    pub max_log_b: f32,
+}
+
+fn default_max_log_b() -> f32 {
+    5.0
+}
+
+/// The ESE loss outside the interval each pass is trained for.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum EseOutside {
+    /// No loss there (thesis eq. 5.13).
+    #[default]
+    Ignore,
+    /// mmlf's padding variant (`ImprovedUncertaintyL1Loss`): `−log b` there, so passes learn
+    /// to be uncertain out of range; the inside and outside means are weighted 50/50.
+    Uncertain,
+    /// Plain UPR on every pixel (what the thesis author's README trains ESE as).
+    Upr,
 }
 
 /// Most ESE inference passes (each is one network evaluation of the scene).
@@ -214,6 +239,8 @@ impl Default for EseConfig {
             range: None,
             step: None,
             scene_range: false,
+            outside: EseOutside::Ignore,
+            max_log_b: default_max_log_b(),
         }
     }
 }
@@ -541,6 +568,9 @@ impl TrainConfig {
         }
         if self.ese.members == 0 || self.ese.members.is_multiple_of(2) || self.ese.delta <= 0.0 {
             bail!("ese.members must be odd and ese.delta positive");
+        }
+        if !(self.ese.max_log_b.is_finite() && self.ese.max_log_b > 0.0) {
+            bail!("ese.max_log_b must be finite and positive");
         }
         if let Some([lo, hi]) = self.ese.range {
             let step = self.ese.step.unwrap_or(self.ese.delta);

@@ -7,7 +7,7 @@
 use burn::prelude::*;
 use burn::tensor::activation::log_softmax;
 
-use crate::config::{DppConfig, ModelKind, TrainConfig};
+use crate::config::{DppConfig, EseOutside, ModelKind, TrainConfig};
 
 /// Targets on the device.
 pub struct TargetTensors {
@@ -35,7 +35,15 @@ pub fn loss(cfg: &TrainConfig, out: Tensor<4>, t: &TargetTensors) -> Tensor<1> {
         ModelKind::Upr => laplace_nll(out, t, t.eta.clone()),
         ModelKind::Ese => {
             let inside = t.disparity.clone().abs().lower_elem(cfg.ese.delta / 2.0);
-            laplace_nll(out, t, t.eta.clone() * inside.float())
+            let w_in = t.eta.clone() * inside.float();
+            match cfg.ese.outside {
+                EseOutside::Ignore => laplace_nll(out, t, w_in),
+                EseOutside::Upr => laplace_nll(out, t, t.eta.clone()),
+                EseOutside::Uncertain => {
+                    let w_out = t.eta.clone() - w_in.clone();
+                    uncertain_outside(out, t, w_in, w_out, cfg.ese.max_log_b)
+                }
+            }
         }
         ModelKind::Dpp => cross_entropy(out, t),
         ModelKind::EpiShift => unreachable!("EPI-Shift's loss is crate::shift_loss"),
@@ -61,6 +69,26 @@ fn laplace_nll(out: Tensor<4>, t: &TargetTensors, weights: Tensor<4>) -> Tensor<
     let n = t.pixels.max(1.0);
     let nll = (t.disparity.clone() - mu).abs() * log_b.clone().neg().exp() + log_b;
     (weights * nll).sum() / n
+}
+
+/// ESE with `outside = "uncertain"` (mmlf's `ImprovedUncertaintyL1Loss`): half the mean
+/// Laplace NLL over the inside weights `w_in`, half the mean `−min(log b, cap)` over the outside
+/// weights `w_out`, each mean over its own weight so a pass sees both however few pixels fall
+/// inside its interval.
+fn uncertain_outside(
+    out: Tensor<4>,
+    t: &TargetTensors,
+    w_in: Tensor<4>,
+    w_out: Tensor<4>,
+    cap: f32,
+) -> Tensor<1> {
+    let mu = channel(&out, 0, &t.disparity);
+    let log_b = channel(&out, 1, &t.disparity);
+    let nll = (t.disparity.clone() - mu).abs() * log_b.clone().neg().exp() + log_b.clone();
+    let mean = |w: Tensor<4>, v: Tensor<4>| (w.clone() * v).sum() / w.sum().clamp_min(1e-6);
+    let inside = mean(w_in, nll);
+    let outside = mean(w_out, log_b.clamp_max(cap).neg());
+    (inside + outside) / 2.0
 }
 
 /// DPP: `−Σ_j η_j log softmax(z)_{bin(d_j)}` (eq. 5.15, 5.16).

@@ -52,6 +52,21 @@ impl TwoPlanes {
         }
     }
 
+    /// The two tiny scenes the training tests learn from: `DIR/train/a`, `DIR/train/b` (5×5
+    /// views of 24², disparities within ±1.25), with multimodal GT when `multimodal`.
+    pub fn write_tiny_pair(dir: &Path, multimodal: bool) -> Result<()> {
+        let base = TwoPlanes::new(5, 24);
+        let b = TwoPlanes {
+            phase: 1.7,
+            centre: (-2.5, 1.5),
+            front: 0.6,
+            back: -0.4,
+            ..base
+        };
+        base.write(&dir.join("train").join("a"), multimodal)?;
+        b.write(&dir.join("train").join("b"), multimodal)
+    }
+
     /// The scene point `p` expressed in the unrotated scene: `R^-turns p` with
     /// `R⁻¹(a, b) = (-b, a)` (the inverse of the quarter turn of [`crate::lightfield`]).
     fn unrotate(&self, (mut a, mut b): (f32, f32)) -> (f32, f32) {

@@ -4,7 +4,7 @@
 
 use burn::prelude::*;
 use burn::tensor::TensorData;
-use lftrain::config::{ModelKind, NetConfig, TrainConfig};
+use lftrain::config::{EseOutside, ModelKind, NetConfig, TrainConfig};
 use lftrain::loss::{TargetTensors, dpp_bin, loss};
 use lftrain::model::{EpiNet, turn_to_reference};
 use lftrain::stacks::{Direction, Region, extract};
@@ -52,6 +52,21 @@ fn losses_match_hand_computed_values() {
     // ESE with Δd = 1: only |d| < .5 counts, i.e. pixel 0's second mode: .75·.5 / 2 pixels.
     let ese = scalar(loss(&cfg(ModelKind::Ese), out(), &targets(&dev)));
     assert!((ese - 0.1875).abs() < 1e-6, "{ese}");
+    // ESE trained as plain UPR: the UPR loss.
+    let mut c = cfg(ModelKind::Ese);
+    c.ese.outside = EseOutside::Upr;
+    let plain = scalar(loss(&c, out(), &targets(&dev)));
+    assert!((plain - upr).abs() < 1e-6, "{plain}");
+    // mmlf's padding variant: inside, pixel 0's second mode (η .75, NLL .5) → mean .5;
+    // outside, pixel 0's first mode (η .25, −log b = 0) and pixel 1 (η 1, −ln 2) → −ln 2/1.25;
+    // the two halves averaged. With log b capped at .5, pixel 1 gives −.5 instead.
+    c.ese.outside = EseOutside::Uncertain;
+    let uncertain = scalar(loss(&c, out(), &targets(&dev)));
+    let want = (0.5 - ln2 / 1.25) / 2.0;
+    assert!((uncertain - want).abs() < 1e-6, "{uncertain} vs {want}");
+    c.ese.max_log_b = 0.5;
+    let capped = scalar(loss(&c, out(), &targets(&dev)));
+    assert!((capped - (0.5 - 0.5 / 1.25) / 2.0).abs() < 1e-6, "{capped}");
 }
 
 #[test]
@@ -178,27 +193,6 @@ fn turning_the_vertical_stack_gives_a_horizontal_stack() {
     }
 }
 
-/// Two tiny scenes: `DIR/train/a`, `DIR/train/b` (5×5 views of 24², multimodal GT).
-fn tiny_dataset(dir: &std::path::Path) {
-    let base = TwoPlanes::new(5, 24);
-    let scenes = [
-        ("a", TwoPlanes { phase: 0.0, ..base }),
-        (
-            "b",
-            TwoPlanes {
-                phase: 1.7,
-                centre: (-2.5, 1.5),
-                front: 0.6,
-                back: -0.4,
-                ..base
-            },
-        ),
-    ];
-    for (name, s) in scenes {
-        s.write(&dir.join("train").join(name), true).unwrap();
-    }
-}
-
 /// A quiet run from `train` (validated on `val`) into `out`, both tiny scenes in the pool.
 fn train_args(
     train: &std::path::Path,
@@ -224,7 +218,7 @@ fn tiny_model_overfits_tiny_dataset_then_predicts_for_lfeval() {
     use lftrain::train::train;
 
     let tmp = tempfile::tempdir().unwrap();
-    tiny_dataset(tmp.path());
+    TwoPlanes::write_tiny_pair(tmp.path(), true).unwrap();
     let data = tmp.path().join("train");
     let mut cfg = TrainConfig {
         model: ModelKind::Base,
@@ -385,7 +379,7 @@ fn a_patch_larger_than_the_scenes_is_refused_naming_the_scene() {
     use lftrain::train::train;
 
     let tmp = tempfile::tempdir().unwrap();
-    tiny_dataset(tmp.path());
+    TwoPlanes::write_tiny_pair(tmp.path(), true).unwrap();
     let cfg = TrainConfig {
         patch: 32,
         batch: 1,
