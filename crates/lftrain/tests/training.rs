@@ -2,9 +2,6 @@
 //! rotation of the network, and a tiny model overfitting a tiny dataset end to end (train →
 //! checkpoint → predict → lfeval).
 
-#[path = "training/epishift.rs"]
-mod epishift;
-
 use burn::prelude::*;
 use burn::tensor::TensorData;
 use lftrain::config::{EseOutside, ModelKind, NetConfig, TrainConfig};

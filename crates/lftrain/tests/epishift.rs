@@ -1,5 +1,4 @@
-//! EPI-Shift (thesis chapter 4), a module of the training tests (one test binary fewer to
-//! link against burn): the losses against hand-computed values, the shift
+//! EPI-Shift (thesis chapter 4): the losses against hand-computed values, the shift
 //! invariance the method rests on, the clipping mask, and a tiny model overfitting a tiny
 //! dataset whose inference then covers a far range given only by `parameters.cfg`.
 
