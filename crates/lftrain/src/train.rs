@@ -1,7 +1,7 @@
 //! The training loop: batches from the [`Loader`], Adam steps, progress, logging, validation
 //! and checkpoints.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
@@ -38,6 +38,21 @@ pub struct TrainArgs {
     pub pool: PoolConfig,
     /// Total steps, overriding the config (also on `--resume`, to extend a finished run).
     pub steps: Option<usize>,
+}
+
+impl TrainArgs {
+    /// A fresh run without a progress bar, for the config's steps (tests and scripts).
+    pub fn quiet(train: &Path, val: Option<&Path>, out: &Path, pool: PoolConfig) -> Self {
+        Self {
+            train: train.to_path_buf(),
+            val: val.map(Path::to_path_buf),
+            out: out.to_path_buf(),
+            resume: false,
+            quiet: true,
+            pool,
+            steps: None,
+        }
+    }
 }
 
 /// The result of a run.

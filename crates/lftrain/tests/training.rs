@@ -199,18 +199,11 @@ fn train_args(
     val: Option<&std::path::Path>,
     out: &std::path::Path,
 ) -> lftrain::train::TrainArgs {
-    lftrain::train::TrainArgs {
-        train: train.to_path_buf(),
-        val: val.map(std::path::Path::to_path_buf),
-        out: out.to_path_buf(),
-        resume: false,
-        quiet: true,
-        pool: lftrain::loader::PoolConfig {
-            scenes: 2,
-            refresh: 1,
-        },
-        steps: None,
-    }
+    let pool = lftrain::loader::PoolConfig {
+        scenes: 2,
+        refresh: 1,
+    };
+    lftrain::train::TrainArgs::quiet(train, val, out, pool)
 }
 
 #[test]
