@@ -132,7 +132,6 @@ fn exclusion(
 #[test]
 fn povray_planar_depth_matches_hci_depth_of_centre_and_corner_views() {
     if !pov::available() {
-        println!("{}", pov::SKIP);
         return;
     }
     let tmp = tempfile::tempdir().unwrap();
@@ -168,7 +167,7 @@ fn povray_planar_depth_matches_hci_depth_of_centre_and_corner_views() {
         "--views",
         "0,2,4,6,8",
     ]);
-    let desc = lfgen::pipeline::read_scene_json(&scene_dir.join("scene.json")).unwrap();
+    let desc = lfgen::scene::SceneDesc::read(&scene_dir.join("scene.json")).unwrap();
     let scene = RenderScene::build_with(&desc, &Assets::load(&desc).unwrap()).unwrap();
     let dmax = dmax(&pov);
     let mut failures = Vec::new();

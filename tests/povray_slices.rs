@@ -43,7 +43,7 @@ mod pov;
 use lfformat::modes::{ModeMap, read_modes_exr};
 use lfgen::config::Config;
 use lfgen::export::extract::ExportScene;
-use lfgen::pipeline::{RenderJob, read_scene_json};
+use lfgen::pipeline::RenderJob;
 use lfgen::render::RenderScene;
 use lfgen::render::geometry::Hit;
 use lfgen::render::view::RenderSettings;
@@ -467,7 +467,6 @@ fn print_tally(name: &str, t: &Tally) {
 #[test]
 fn slice_renders_composited_with_over_match_the_single_pass_ground_truth() {
     if !pov::available() {
-        println!("{}", pov::SKIP);
         return;
     }
     let tmp = tempfile::tempdir().unwrap();
@@ -489,7 +488,7 @@ fn slice_renders_composited_with_over_match_the_single_pass_ground_truth() {
         "--views",
         &VIEW.to_string(),
     ]));
-    let desc = read_scene_json(&scene_dir.join("scene.json")).unwrap();
+    let desc = SceneDesc::read(&scene_dir.join("scene.json")).unwrap();
     assert_eq!(desc.camera.center_view(), VIEW);
     let assets = Assets::load(&desc).unwrap();
     let scene = RenderScene::build_with(&desc, &assets).unwrap();

@@ -5,16 +5,20 @@
 use std::path::Path;
 use std::process::Command;
 
-/// What a test prints when it cannot run.
-pub const SKIP: &str =
-    "SKIPPED: povray is not installed (apt-get install povray); .ci/run installs it";
-
-/// Whether POV-Ray is on the PATH.
+/// Whether the POV-Ray comparison can run. Without `povray` on the PATH a developer's run
+/// prints why and skips; under CI (`CI` set, as `.ci/run` runs) it fails instead, so a broken
+/// install step cannot turn the depth validation into a silent pass.
 pub fn available() -> bool {
-    Command::new("povray")
+    let found = Command::new("povray")
         .arg("--version")
         .output()
-        .is_ok_and(|o| String::from_utf8_lossy(&o.stderr).contains("POV-Ray"))
+        .is_ok_and(|o| String::from_utf8_lossy(&o.stderr).contains("POV-Ray"));
+    let why = "povray is not installed (apt-get install povray; .ci/run installs it)";
+    assert!(found || std::env::var_os("CI").is_none(), "CI: {why}");
+    if !found {
+        println!("SKIPPED: {why}");
+    }
+    found
 }
 
 /// Renders `scene` (a file in `dir`, where its includes are) into `png` with the options

@@ -87,12 +87,16 @@ pub fn sha256_file(path: &Path) -> Result<(String, u64)> {
         hasher.update(&buffer[..n]);
         bytes += n as u64;
     }
-    let hex = hasher
-        .finalize()
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect();
-    Ok((hex, bytes))
+    Ok((hex(&hasher.finalize()), bytes))
+}
+
+/// Lowercase hex SHA-256 of `bytes` (content keys of assets, textures and configs).
+pub fn hex_sha256(bytes: &[u8]) -> String {
+    hex(&Sha256::digest(bytes))
+}
+
+fn hex(digest: &[u8]) -> String {
+    digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 
 /// Checks every file of `e` under `root`, naming the first that is missing, has another size
