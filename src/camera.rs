@@ -5,7 +5,6 @@
 //! the top row), and its sensor is shifted so the focus plane stays in register (SPEC §2).
 //! Ray directions have a forward component of exactly 1, so a hit's `t` *is* its planar depth.
 
-use crate::config::CameraConfig;
 use anyhow::{Result, ensure};
 use glam::{DVec3, Vec3};
 use serde::{Deserialize, Serialize};
@@ -36,17 +35,11 @@ pub struct CameraRay {
 }
 
 impl LightFieldCamera {
-    /// The grid of `cfg` whose centre camera stands at `position` looking along `forward`
-    /// (`up` is made orthogonal to it), with the vertical field of view `yfov` (radians) on
-    /// the configured image: `f_px = H/2 / tan(yfov/2)`. The focal length is stored HCI-style
-    /// on the configured sensor, `f_mm = f_px · sensor_size_mm / max(W, H)`.
-    pub fn looking(
-        cfg: &CameraConfig,
-        position: DVec3,
-        forward: DVec3,
-        up: DVec3,
-        yfov: f64,
-    ) -> Result<Self> {
+    /// This rig (image, grid, sensor, baseline, focus) with its centre camera at `position`
+    /// looking along `forward` (`up` is made orthogonal to it) and the vertical field of view
+    /// `yfov` (radians) on the image: `f_px = H/2 / tan(yfov/2)`. The focal length is stored
+    /// HCI-style on the sensor, `f_mm = f_px · sensor_size_mm / max(W, H)`.
+    pub fn looking(&self, position: DVec3, forward: DVec3, up: DVec3, yfov: f64) -> Result<Self> {
         ensure!(
             yfov.is_finite() && yfov > 0.0 && yfov < std::f64::consts::PI,
             "vertical field of view {yfov} rad is not in (0, π)"
@@ -62,18 +55,14 @@ impl LightFieldCamera {
         let Some((forward, up)) = frame else {
             anyhow::bail!("camera forward {forward} and up {up} do not span a view");
         };
-        let [w, h] = cfg.resolution;
+        let [w, h] = self.resolution;
         let f_px = h as f64 / 2.0 / (yfov / 2.0).tan();
         Ok(Self {
-            resolution: cfg.resolution,
-            grid: cfg.grid,
-            focal_length_mm: f_px * cfg.sensor_size_mm / w.max(h) as f64,
-            sensor_size_mm: cfg.sensor_size_mm,
-            baseline_m: cfg.baseline_mm / 1000.0,
-            focus_distance_m: cfg.focus_distance_m,
+            focal_length_mm: f_px * self.sensor_size_mm / w.max(h) as f64,
             position,
             forward,
             up,
+            ..*self
         })
     }
 
@@ -275,27 +264,27 @@ mod tests {
 
     #[test]
     fn looking_sets_the_vertical_field_of_view_and_an_orthonormal_frame() {
-        let cfg = CameraConfig {
+        let rig = LightFieldCamera {
             resolution: [64, 48],
-            ..CameraConfig::default()
+            ..camera()
         };
         let yfov = 0.7f64;
-        let c = LightFieldCamera::looking(
-            &cfg,
-            DVec3::ZERO,
-            DVec3::new(0.0, 0.0, -2.0),
-            DVec3::new(0.0, 1.0, 0.5),
-            yfov,
-        )
-        .unwrap();
+        let c = rig
+            .looking(
+                DVec3::ZERO,
+                DVec3::new(0.0, 0.0, -2.0),
+                DVec3::new(0.0, 1.0, 0.5),
+                yfov,
+            )
+            .unwrap();
         assert!((c.f_px() - 24.0 / (yfov / 2.0).tan()).abs() < 1e-9);
         // The top edge of the image is yfov/2 above the axis.
         let top = c.view_rays(c.center_view()).ray(32.0, 0.0).dir.as_dvec3();
         assert!((top.y.atan2(-top.z) - yfov / 2.0).abs() < 1e-6);
         assert!(c.up.dot(c.forward).abs() < 1e-12 && (c.up.length() - 1.0).abs() < 1e-12);
-        let parallel = LightFieldCamera::looking(&cfg, DVec3::ZERO, DVec3::Y, DVec3::Y, yfov);
+        let parallel = rig.looking(DVec3::ZERO, DVec3::Y, DVec3::Y, yfov);
         assert!(parallel.is_err());
-        assert!(LightFieldCamera::looking(&cfg, DVec3::ZERO, DVec3::Z, DVec3::Y, 3.2).is_err());
+        assert!(rig.looking(DVec3::ZERO, DVec3::Z, DVec3::Y, 3.2).is_err());
     }
 
     #[test]

@@ -5,7 +5,10 @@
 //! deserialising, so a `--set` key goes through the same validation as a key in the file, and
 //! unknown keys are rejected by name instead of being silently ignored.
 
+use crate::camera::LightFieldCamera;
 use crate::output::images::ToneCurve;
+pub use crate::scene::SliceSpacing;
+use crate::scene::{MAX_GRID, MAX_SLICES};
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -49,6 +52,21 @@ impl Default for DatasetConfig {
             date: String::new(),
         }
     }
+}
+
+impl DatasetConfig {
+    /// The date written into every scene: `dataset.date`, or today (UTC) when it is empty.
+    pub fn render_date(&self) -> String {
+        match self.date.is_empty() {
+            true => today(),
+            false => self.date.clone(),
+        }
+    }
+}
+
+/// Today's date (UTC) as `YYYY-MM-DD`.
+pub fn today() -> String {
+    humantime::format_rfc3339(std::time::SystemTime::now()).to_string()[..10].to_string()
 }
 
 /// How baseline and focus distance are chosen.
@@ -96,22 +114,31 @@ impl Default for CameraConfig {
     }
 }
 
+impl CameraConfig {
+    /// The configured rig (image, grid, lens, sensor, baseline, focus) at the origin looking
+    /// down −Z: the scene builders place and aim it, and framing may replace baseline and
+    /// focus (`camera.baseline = "auto"`).
+    pub fn rig(&self) -> LightFieldCamera {
+        LightFieldCamera {
+            resolution: self.resolution,
+            grid: self.grid,
+            focal_length_mm: self.focal_length_mm,
+            sensor_size_mm: self.sensor_size_mm,
+            baseline_m: self.baseline_mm / 1000.0,
+            focus_distance_m: self.focus_distance_m,
+            position: glam::DVec3::ZERO,
+            forward: glam::DVec3::NEG_Z,
+            up: glam::DVec3::Y,
+        }
+    }
+}
+
 /// Which views get multimodal ground truth.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum GtViews {
     Center,
     All,
-}
-
-/// How the depth range is cut into slices.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum SliceSpacing {
-    /// Equal depth (the thesis' choice).
-    Depth,
-    /// Equal disparity (equal 1/Z).
-    Disparity,
 }
 
 /// Which depth decides a hit's slice.
@@ -333,12 +360,8 @@ pub const PRESETS: &[(&str, &[&str])] = &[
     ("wide", &["camera.disparity_range=[-40.0,40.0]"]),
 ];
 
-/// Largest camera grid side (HCI uses 9; 33 × 33 views is already 1 089 renders).
-pub const MAX_GRID: u32 = 33;
 /// Largest samples per pixel.
 pub const MAX_SPP: u32 = 1 << 16;
-/// Largest slice count (every pixel of a thread keeps a few values per slice).
-pub const MAX_SLICES: u32 = 4096;
 /// Longest path.
 pub const MAX_DEPTH: u32 = 1024;
 /// Largest room side: scene descriptions hold positions up to 1e6 m, and a room far larger
@@ -477,7 +500,7 @@ impl Config {
     /// SHA-256 of the canonical JSON form: identifies the config in the manifest.
     pub fn hash(&self) -> String {
         let json = serde_json::to_vec(self).expect("config serialises");
-        crate::output::hex_sha256(&json)
+        lfformat::manifest::hex_sha256(&json)
     }
 }
 

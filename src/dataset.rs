@@ -84,12 +84,7 @@ pub fn generate(cfg: &Config, opts: &GenerateOptions) -> Result<()> {
     let todo: Vec<u64> = (0..opts.scenes)
         .filter(|i| i % opts.shard.1 == opts.shard.0)
         .collect();
-    let date = if cfg.dataset.date.is_empty() {
-        today()
-    } else {
-        cfg.dataset.date.clone()
-    };
-    let job = RenderJob::from_config(cfg, &date);
+    let job = RenderJob::from_config(cfg, &cfg.dataset.render_date());
     let library = open_library(cfg, opts.strict)?;
     let [w, h] = cfg.camera.resolution;
     let per_scene = w as u64
@@ -456,9 +451,4 @@ fn write_summary(out: &Path, dirs: &[String]) -> Result<()> {
         &out.join("summary.json"),
         text.as_bytes(),
     )?)
-}
-
-/// Today's date (UTC) as `YYYY-MM-DD`.
-pub(crate) fn today() -> String {
-    humantime::format_rfc3339(std::time::SystemTime::now()).to_string()[..10].to_string()
 }

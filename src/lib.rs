@@ -16,3 +16,4 @@ pub mod render;
 pub mod scene;
 pub mod stats;
 pub mod textures;
+pub mod util;

@@ -189,7 +189,7 @@ fn run(cli: Cli) -> Result<()> {
             lfgen::pipeline::render_file(&cfg, &a.scene, camera, &a.out, a.common.quiet)
         }
         Some(Command::Textures { count, out, seed }) => {
-            let cat = lfgen::textures::write_library(&out, count, seed)?;
+            let cat = lfgen::output::texture_library::write_library(&out, count, seed)?;
             println!(
                 "{}: {} textures and catalog.json",
                 out.display(),

@@ -108,13 +108,17 @@ pub fn generate_scene(
         .context("the generator made an invalid scene")?;
     let assets = Assets::load(&desc)?;
     let scene = RenderScene::build_with(&desc, &assets)?;
-    desc.slices = scene.frame(
-        &mut desc.camera,
-        &cfg.camera,
-        cfg.render.slices,
-        cfg.render.slice_spacing,
-    )?;
+    frame(&mut desc, &scene, cfg)?;
     Ok((desc, scene))
+}
+
+/// Fits the camera (automatic baseline and focus) and the slices of a new scene to the depth
+/// range its camera grid sees, replacing the placeholders it was built with.
+fn frame(desc: &mut SceneDesc, scene: &RenderScene, cfg: &Config) -> Result<()> {
+    let fit = (cfg.camera.baseline == BaselineMode::Auto).then_some(cfg.camera.disparity_range);
+    let r = &cfg.render;
+    (desc.camera, desc.slices) = scene.frame(&desc.camera, fit, r.slices, r.slice_spacing)?;
+    Ok(())
 }
 
 /// Renders every view of `desc` into `final_dir` (atomically) and returns the published files.
@@ -243,14 +247,7 @@ pub fn render_gltf(cfg: &Config, gltf: &Path, out: &Path, quiet: bool) -> Result
         .with_context(|| format!("{}: unsupported scene", gltf.display()))?;
     let scene = RenderScene::build_with(&desc, &imported.assets)
         .with_context(|| gltf.display().to_string())?;
-    desc.slices = scene
-        .frame(
-            &mut desc.camera,
-            &cfg.camera,
-            cfg.render.slices,
-            cfg.render.slice_spacing,
-        )
-        .with_context(|| gltf.display().to_string())?;
+    frame(&mut desc, &scene, cfg).with_context(|| gltf.display().to_string())?;
     let (near, far) = (desc.slices.z_near, desc.slices.z_far);
     if cfg.camera.baseline == BaselineMode::Auto && far < 1.1 * near {
         eprintln!(
@@ -260,40 +257,22 @@ pub fn render_gltf(cfg: &Config, gltf: &Path, out: &Path, quiet: bool) -> Result
             desc.camera.baseline_m
         );
     }
-    let job = RenderJob::from_config(cfg, &render_date(cfg));
+    let job = RenderJob::from_config(cfg, &cfg.dataset.render_date());
     publish(&mut desc, &scene, &job, out, quiet)
 }
 
 /// `lfgen render SCENE.json --out DIR`: renders a saved scene again, with its saved camera,
 /// slices and exposure, and the render settings of `cfg`.
 pub fn rerender(cfg: &Config, scene_json: &Path, out: &Path, quiet: bool) -> Result<()> {
-    let mut desc = read_scene_json(scene_json)?;
+    let mut desc = SceneDesc::read(scene_json)?;
     let assets = Assets::load(&desc).with_context(|| scene_json.display().to_string())?;
     let scene = RenderScene::build_with(&desc, &assets)
         .with_context(|| scene_json.display().to_string())?;
     let job = RenderJob {
         auto_exposure: false,
-        ..RenderJob::from_config(cfg, &render_date(cfg))
+        ..RenderJob::from_config(cfg, &cfg.dataset.render_date())
     };
     publish(&mut desc, &scene, &job, out, quiet)
-}
-
-/// Reads a saved `scene.json`, naming the file in errors.
-pub fn read_scene_json(path: &Path) -> Result<SceneDesc> {
-    let bytes = crate::scene::files::read_limited(path)?;
-    let desc: SceneDesc = serde_json::from_slice(&bytes)
-        .with_context(|| format!("{}: not a valid lfgen scene", path.display()))?;
-    desc.validate()
-        .with_context(|| format!("{}: not a valid lfgen scene", path.display()))?;
-    Ok(desc)
-}
-
-/// `dataset.date`, or today when it is empty.
-fn render_date(cfg: &Config) -> String {
-    match cfg.dataset.date.is_empty() {
-        true => crate::dataset::today(),
-        false => cfg.dataset.date.clone(),
-    }
 }
 
 /// Renders one scene into the folder `out` (its parent is created) and reports it.

@@ -53,7 +53,7 @@ pub fn export_scene_dir(
     limits: PathLimits,
 ) -> Result<()> {
     let json = scene_dir.join("scene.json");
-    let desc = crate::pipeline::read_scene_json(&json)?;
+    let desc = crate::scene::SceneDesc::read(&json)?;
     let assets = Assets::load(&desc).with_context(|| json.display().to_string())?;
     let views = views.resolve(&desc.camera)?;
     let scene =

@@ -17,7 +17,7 @@
 use super::extract::{
     DepthVisibility, ExportCamera, ExportMesh, ExportScene, mean_color, mean_emission, mean_opacity,
 };
-use crate::config::SliceSpacing;
+use crate::scene::SliceSpacing;
 use crate::scene::{Light, Opacity, SliceRange, SurfaceModel};
 use anyhow::Result;
 use glam::{DVec3, Vec3};

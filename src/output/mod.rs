@@ -7,13 +7,4 @@
 pub mod images;
 pub mod preview;
 pub mod scene_dir;
-
-use sha2::{Digest, Sha256};
-
-/// Lowercase hex SHA-256 of `bytes`.
-pub fn hex_sha256(bytes: &[u8]) -> String {
-    Sha256::digest(bytes)
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect()
-}
+pub mod texture_library;

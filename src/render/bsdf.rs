@@ -576,11 +576,9 @@ mod tests {
 
     impl Rng {
         fn next(&mut self) -> f32 {
+            let h = crate::util::hash::mix64(self.0);
             self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = self.0;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+            crate::util::hash::unit_float(h)
         }
 
         fn next2(&mut self) -> Vec2 {

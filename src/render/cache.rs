@@ -20,8 +20,8 @@
 //! too. Filling bands in parallel and merging them in band order keeps every sum in a fixed
 //! order: the cache, and so every image, is byte-identical for any thread count.
 
-use super::sampler::mix64;
 use crate::camera::LightFieldCamera;
+use crate::util::hash::mix64;
 use glam::{DVec3, I64Vec3, Vec3};
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};

@@ -3,8 +3,8 @@
 
 use super::RenderScene;
 use crate::camera::LightFieldCamera;
-use crate::config::{BaselineMode, CameraConfig, SliceSpacing};
-use crate::scene::SliceRange;
+use crate::scene::{SliceRange, SliceSpacing};
+use crate::util::colour::luminance;
 use glam::Vec3;
 
 /// Rays per image side of the depth probe (per corner and centre view).
@@ -48,37 +48,35 @@ impl RenderScene {
         (near.is_finite() && far >= near).then_some((near as f64, far as f64))
     }
 
-    /// Sets the camera's baseline and focus (auto mode) and returns the slice partition.
+    /// The framed camera and the slice partition of its depth range.
     ///
     /// The probed range is widened by 2 % at each end so surfaces between probe rays still fall
-    /// inside it; with `baseline = "auto"` that widened range maps exactly onto the configured
-    /// disparity range.
+    /// inside it. With `fit_disparity = Some(range)` (the automatic baseline) the camera's
+    /// baseline and focus are chosen so that the widened range maps exactly onto `range`;
+    /// with `None` the camera is kept as it is.
     pub fn frame(
         &self,
-        cam: &mut LightFieldCamera,
-        cfg: &CameraConfig,
+        cam: &LightFieldCamera,
+        fit_disparity: Option<[f64; 2]>,
         slices: u32,
         spacing: SliceSpacing,
-    ) -> anyhow::Result<SliceRange> {
+    ) -> anyhow::Result<(LightFieldCamera, SliceRange)> {
         let (near, far) = self.probe_depth_range(cam).ok_or_else(|| {
             anyhow::anyhow!("the camera sees no closed geometry: cannot fit a depth range")
         })?;
         let (z_near, z_far) = (near * 0.98, far * 1.02);
-        if cfg.baseline == BaselineMode::Auto {
-            cam.fit_disparity_range(z_near, z_far, cfg.disparity_range);
+        let mut cam = cam.clone();
+        if let Some(range) = fit_disparity {
+            cam.fit_disparity_range(z_near, z_far, range);
         }
-        Ok(SliceRange {
+        let slices = SliceRange {
             z_near,
             z_far,
             count: slices,
             spacing,
-        })
+        };
+        Ok((cam, slices))
     }
-}
-
-/// Mean luminance weights (Rec. 709).
-pub fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
 }
 
 /// Exposure mapping the log-average luminance of `pixels` to middle grey (0.18).

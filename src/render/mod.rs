@@ -14,19 +14,15 @@ pub mod sampler;
 pub mod slices;
 pub mod view;
 
-use crate::scene::SceneDesc;
 use crate::scene::assets::Assets;
 use crate::scene::shapes::tessellate;
+use crate::scene::{MAX_TRIANGLES, SceneDesc};
 use anyhow::{Context, Result, bail, ensure};
 use geometry::{Geometry, SceneTri};
 use glam::Vec3;
 use lights::{Lights, PunctualLight};
 use material::RenderMaterial;
 use rayon::prelude::*;
-
-/// Most triangles a scene may have after instancing (a bound on memory: ~0.4 KB each with
-/// the BVH).
-pub const MAX_TRIANGLES: usize = 20_000_000;
 
 /// A scene ready to trace: triangles in a BVH, resolved materials and lights.
 pub struct RenderScene {

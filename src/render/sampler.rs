@@ -11,22 +11,8 @@
 //! dimension ([`Sampler::start_vertex`]) so that a dimension means the same decision in every
 //! sample of the pixel.
 
+use crate::util::hash::{mix64, unit_float};
 use glam::Vec2;
-
-/// SplitMix64 finaliser: a cheap, well-mixed 64-bit hash.
-#[inline]
-pub fn mix64(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
-/// Uniform float in [0, 1) from a hash value.
-#[inline]
-pub fn unit_float(h: u64) -> f32 {
-    (h >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
-}
 
 /// Dimensions reserved per path vertex: the light sample (choice and point), the continuation
 /// choice, the lobe choice and direction, Russian roulette and the next ray's transparency

@@ -164,8 +164,8 @@ impl SliceAccumulator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::SliceSpacing;
     use crate::scene::SliceRange;
+    use crate::scene::SliceSpacing;
 
     fn range() -> SliceRange {
         SliceRange {

@@ -17,8 +17,9 @@ use super::{
 };
 use crate::camera::LightFieldCamera;
 use crate::config::Config;
-use crate::render::sampler::mix64;
 use crate::textures::generators::{FAMILIES, Family};
+use crate::util::colour::luminance;
+use crate::util::hash::mix64;
 use glam::{DVec3, Quat, Vec2, Vec3};
 use rand::RngExt;
 use rand_pcg::Pcg32;
@@ -67,7 +68,7 @@ pub fn generate(cfg: &Config, index: u64, library: Option<&AssetLibrary>) -> Sce
         index,
         seed: cfg.dataset.seed,
         camera,
-        slices: SliceRange::unframed(&cfg.render),
+        slices: SliceRange::unframed(cfg.render.slices, cfg.render.slice_spacing),
         environment: s.environment.map(|v| v as f32),
         exposure: cfg.render.exposure as f32,
         materials: g.materials,
@@ -800,19 +801,13 @@ impl Gen<'_> {
 
     /// The centre camera: near the front wall at eye height, looking into the room.
     fn camera(&mut self, size: Vec3) -> LightFieldCamera {
-        let c = &self.cfg.camera;
+        let rig = self.cfg.camera.rig();
         let yaw = (self.unit() - 0.5) * 0.2;
         let pitch = -0.1 - 0.12 * self.unit();
         let forward =
             DVec3::new(-(yaw.sin() as f64), pitch.sin() as f64, -(yaw.cos() as f64)).normalize();
         let up = (DVec3::Y - forward * forward.y).normalize();
         LightFieldCamera {
-            resolution: c.resolution,
-            grid: c.grid,
-            focal_length_mm: c.focal_length_mm,
-            sensor_size_mm: c.sensor_size_mm,
-            baseline_m: c.baseline_mm / 1000.0,
-            focus_distance_m: c.focus_distance_m,
             position: DVec3::new(
                 0.0,
                 1.2 + 0.4 * self.unit() as f64,
@@ -820,6 +815,7 @@ impl Gen<'_> {
             ),
             forward,
             up,
+            ..rig
         }
     }
 
@@ -1133,8 +1129,7 @@ fn kelvin_rgb(kelvin: f32) -> [f32; 3] {
     let warm = Vec3::new(1.0, 0.62, 0.30);
     let cool = Vec3::new(0.95, 0.98, 1.05);
     let c = warm.lerp(cool, t);
-    let lum = c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
-    (c / lum).to_array()
+    (c / luminance(c)).to_array()
 }
 
 #[cfg(test)]
@@ -1350,7 +1345,7 @@ mod tests {
     fn colour_temperatures_are_warm_to_cool_at_unit_luminance() {
         let (warm, cool) = (kelvin_rgb(2700.0), kelvin_rgb(6500.0));
         assert!(warm[0] > warm[2] && cool[2] > cool[0]);
-        let lum = |c: [f32; 3]| Vec3::from(c).dot(Vec3::new(0.2126, 0.7152, 0.0722));
+        let lum = |c: [f32; 3]| luminance(Vec3::from(c));
         assert!((lum(warm) - 1.0).abs() < 1e-5 && (lum(cool) - 1.0).abs() < 1e-5);
     }
 }

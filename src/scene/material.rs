@@ -3,6 +3,7 @@
 //! (evaluated on the mesh's own texture coordinates).
 
 use super::texture_image::ImageMap;
+use crate::util::hash::{mix64, unit_float};
 use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 
@@ -222,7 +223,7 @@ fn value_noise(p: Vec2, seed: u32) -> f32 {
 
 fn lattice(i: i32, j: i32, seed: u32) -> f32 {
     let key = ((i as u32 as u64) << 32 | j as u32 as u64) ^ ((seed as u64) << 17);
-    (crate::render::sampler::mix64(key) >> 40) as f32 / (1u64 << 24) as f32
+    unit_float(mix64(key))
 }
 
 #[cfg(test)]

@@ -23,7 +23,6 @@ pub mod texture_image;
 mod validate;
 
 use crate::camera::LightFieldCamera;
-use crate::config::SliceSpacing;
 use glam::{Quat, Vec3};
 pub use light::Light;
 pub use material::{Material, Opacity, SurfaceModel, Texture};
@@ -86,6 +85,24 @@ pub struct Resource {
     pub sha256: String,
 }
 
+/// How the depth range is cut into slices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SliceSpacing {
+    /// Equal depth (the thesis' choice).
+    Depth,
+    /// Equal disparity (equal 1/Z).
+    Disparity,
+}
+
+/// Largest camera grid side (HCI uses 9; 33 × 33 views is already 1 089 renders).
+pub const MAX_GRID: u32 = 33;
+/// Largest slice count (every pixel of a thread keeps a few values per slice).
+pub const MAX_SLICES: u32 = 4096;
+/// Most triangles a scene may have after instancing (a bound on memory: ~0.4 KB each with
+/// the BVH).
+pub const MAX_TRIANGLES: usize = 20_000_000;
+
 /// The depth range `[z_near, z_far]` cut into `count` slices.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -98,13 +115,13 @@ pub struct SliceRange {
 
 impl SliceRange {
     /// The partition a new scene carries until the renderer frames it (measures its depth
-    /// range); only the count and spacing come from the config.
-    pub fn unframed(render: &crate::config::RenderConfig) -> Self {
+    /// range); only the count and spacing are known before.
+    pub fn unframed(count: u32, spacing: SliceSpacing) -> Self {
         Self {
             z_near: 0.1,
             z_far: 100.0,
-            count: render.slices,
-            spacing: render.slice_spacing,
+            count,
+            spacing,
         }
     }
 

@@ -5,11 +5,11 @@
 //! field and the value, so the error points at the line to fix, and the bounds keep a bad
 //! number from allocating gigabytes or looping for hours.
 
+use super::{MAX_GRID, MAX_SLICES, MAX_TRIANGLES};
 use super::{Material, Object, Opacity, SceneDesc, Shape, SliceRange, SurfaceModel, Texture};
 use crate::camera::LightFieldCamera;
-use crate::config::{MAX_GRID, MAX_SLICES};
-use crate::render::MAX_TRIANGLES;
-use anyhow::{Result, bail, ensure};
+use anyhow::{Context, Result, bail, ensure};
+use std::path::Path;
 
 /// Largest image side (as `camera.resolution` of the config).
 const MAX_RESOLUTION: u32 = 16384;
@@ -21,6 +21,17 @@ const MAX_SEGMENTS: u32 = 65536;
 const MAX_EXTENT: f32 = 1e6;
 
 impl SceneDesc {
+    /// Reads a saved `scene.json` and validates it, naming the file in errors: the scene
+    /// layer owns both the type and its checks, so no reader can skip them.
+    pub fn read(path: &Path) -> Result<Self> {
+        let bytes = super::files::read_limited(path)?;
+        let desc: SceneDesc = serde_json::from_slice(&bytes)
+            .with_context(|| format!("{}: not a valid lfgen scene", path.display()))?;
+        desc.validate()
+            .with_context(|| format!("{}: not a valid lfgen scene", path.display()))?;
+        Ok(desc)
+    }
+
     /// Checks every field the renderer relies on; the error names the field.
     pub fn validate(&self) -> Result<()> {
         check_camera(&self.camera)?;

@@ -6,7 +6,7 @@
 //! with the tile for the irregular ones. Seamlessness is therefore exact, not blended.
 
 use super::noise::{fbm, value};
-use crate::render::sampler::mix64;
+use crate::util::hash::{mix64, unit_float};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
@@ -67,7 +67,7 @@ struct Draw(u64);
 impl Draw {
     fn unit(&mut self) -> f32 {
         self.0 = mix64(self.0);
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
+        unit_float(self.0)
     }
 
     fn range(&mut self, a: f32, b: f32) -> f32 {
@@ -200,7 +200,7 @@ fn tiles(
     if fx < g || fy < g * cols as f32 / rows as f32 {
         return grout * (0.9 + 0.1 * value(u, v, 64, s));
     }
-    let tint = (mix64(s ^ (row as u64) << 20 ^ col as u64) >> 40) as f32 / (1u64 << 24) as f32;
+    let tint = unit_float(mix64(s ^ (row as u64) << 20 ^ col as u64));
     cell * (0.85 + 0.2 * tint) * (0.92 + 0.08 * fbm(u, v, 16, 3, s + 1))
 }
 
@@ -214,7 +214,7 @@ fn grain(u: f32, v: f32, n: u32, a: Vec3, b: Vec3, s: u64) -> Vec3 {
 fn planks(u: f32, v: f32, n: u32, a: Vec3, b: Vec3, s: u64) -> Vec3 {
     let y = v * n as f32;
     let row = y.floor() as u32;
-    let shift = (mix64(s ^ row as u64) >> 40) as f32 / (1u64 << 24) as f32;
+    let shift = unit_float(mix64(s ^ row as u64));
     let x = (u + shift).fract();
     if y.fract() < 0.03 || x < 0.006 {
         return b * 0.5;

@@ -1,12 +1,12 @@
 //! Periodic noise: value noise whose lattice wraps with the tile, so everything built from it
 //! tiles seamlessly by construction.
 
-use crate::render::sampler::mix64;
+use crate::util::hash::{mix64, unit_float};
 
 /// Lattice value in [0, 1) at integer point (i, j) of a `period`-wrapped lattice.
 fn lattice(i: i64, j: i64, period: i64, seed: u64) -> f32 {
     let (i, j) = (i.rem_euclid(period) as u64, j.rem_euclid(period) as u64);
-    (mix64(seed ^ mix64(i << 32 | j)) >> 40) as f32 / (1u64 << 24) as f32
+    unit_float(mix64(seed ^ mix64(i << 32 | j)))
 }
 
 /// Smooth value noise in [0, 1) at (u, v) ∈ [0, 1)², with `cells` lattice cells per tile side;

@@ -64,7 +64,7 @@ fn import_file(path: &Path, cfg: &Config) -> Result<Imported> {
         index: 0,
         seed: cfg.dataset.seed,
         camera,
-        slices: SliceRange::unframed(&cfg.render),
+        slices: SliceRange::unframed(cfg.render.slices, cfg.render.slice_spacing),
         environment: environment.map(|v| v as f32),
         exposure: cfg.render.exposure as f32,
         materials,

@@ -180,14 +180,11 @@ pub(super) fn camera(
         let position = DVec3::from(g.camera_position);
         let forward = DVec3::from(g.camera_look_at) - position;
         let yfov = g.camera_yfov_deg.to_radians();
-        return LightFieldCamera::looking(
-            &cfg.camera,
-            position,
-            forward,
-            DVec3::from(g.camera_up),
-            yfov,
-        )
-        .context("gltf.camera = \"config\"");
+        return cfg
+            .camera
+            .rig()
+            .looking(position, forward, DVec3::from(g.camera_up), yfov)
+            .context("gltf.camera = \"config\"");
     }
     let cameras: Vec<(&Placed, ::gltf::Camera)> = placed
         .iter()
@@ -226,7 +223,9 @@ pub(super) fn camera(
         -m.z_axis.truncate(),
         m.y_axis.truncate(),
     );
-    LightFieldCamera::looking(&cfg.camera, position, forward, up, persp.yfov() as f64)
+    cfg.camera
+        .rig()
+        .looking(position, forward, up, persp.yfov() as f64)
         .with_context(|| format!("camera on {}", p.label()))
 }
 

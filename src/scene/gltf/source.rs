@@ -2,13 +2,13 @@
 //! crate's index validation, and buffers and images resolved by lfgen itself — a URI may only
 //! name a file beside the glTF (or below its folder) or be a base64 `data:` URI of bounded size.
 
-use crate::output::hex_sha256;
 use crate::scene::files::{read_limited, resolve_inside};
 use crate::scene::texture_image::TextureImage;
 use crate::scene::{Resource, SourceFile};
 use ::gltf::buffer::View;
 use anyhow::{Context, Result, anyhow, bail, ensure};
 use base64::Engine;
+use lfformat::manifest::hex_sha256;
 use std::borrow::Cow;
 use std::cell::RefCell;
 use std::collections::BTreeMap;
