@@ -9,12 +9,11 @@
 //! Layout: [`bins`] and [`laplace`] are the discretisation maths, [`posterior`] the predicted
 //! distributions, [`truth`] the ground truth, [`metrics`] the pure metric functions,
 //! [`scene_eval`] one method on one scene, [`summary`] one method over a dataset,
-//! [`dataset`] and [`prediction`] (with [`npz`]) the files read, [`pipeline`] the dataset
+//! [`prediction`] (with [`npz`]) the files read (scene discovery and views: `lfformat`), [`pipeline`] the dataset
 //! loops with I/O and progress, [`report`] the output files.
 
 pub mod baseline;
 pub mod bins;
-pub mod dataset;
 pub mod laplace;
 pub mod metrics;
 pub mod npz;

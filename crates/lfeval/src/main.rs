@@ -5,16 +5,16 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
-use lfeval::baseline::views::ViewSet;
 use lfeval::baseline::{BaselineConfig, DEFAULT_TEMPERATURE, DEFAULT_WINDOW};
 use lfeval::bins::Bins;
-use lfeval::dataset::{PARAMETERS_FILE, SceneDir, discover};
 use lfeval::metrics::kld::EPSILON;
 use lfeval::pipeline::{self, EvalOptions};
 use lfeval::prediction::Method;
 use lfeval::report::{self, samples::PixelRequest};
 use lfeval::scene_eval::EvalConfig;
 use lfeval::truth::{EtaKind, Reference};
+use lfformat::dataset::{PARAMETERS_FILE, SceneDir, discover};
+use lfformat::views::ViewSet;
 
 /// Evaluates light-field disparity predictions against lfgen or HCI ground truth.
 ///
@@ -151,8 +151,8 @@ struct BaselineArgs {
     common: Common,
     #[command(flatten)]
     bins: BinArgs,
-    /// Views entering the photo-consistency cost.
-    #[arg(long, value_enum, default_value = "cross")]
+    /// Views entering the photo-consistency cost: cross, star or full.
+    #[arg(long, default_value = "cross")]
     views: ViewSet,
     /// Softmax temperature, in units of the cost (colour variance, colours in [0, 1]).
     #[arg(long, default_value_t = DEFAULT_TEMPERATURE)]
@@ -220,7 +220,7 @@ fn setup(dataset: &std::path::Path, common: &Common) -> Result<Vec<SceneDir>> {
             .build_global()
             .context("cannot set up the worker threads")?;
     }
-    discover(dataset, &common.splits)
+    Ok(discover(dataset, &common.splits)?)
 }
 
 fn evaluate(a: EvalArgs) -> Result<()> {

@@ -11,10 +11,8 @@ use indicatif::{ParallelProgressIterator, ProgressBar, ProgressIterator, Progres
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::baseline::views::{LightField, centre_view};
 use crate::baseline::{self, BaselineConfig};
 use crate::bins::Bins;
-use crate::dataset::SceneDir;
 use crate::prediction::{Method, write_prediction};
 use crate::report::errormap::{self, badpix_map, luminance};
 use crate::report::samples::{PixelRequest, PosteriorSample, auto_pixels};
@@ -22,6 +20,8 @@ use crate::report::{ERROR_MAP_DIR, Evaluation, MethodResult};
 use crate::scene_eval::{EvalConfig, MAIN_BADPIX, PreparedTruth, SceneScores, evaluate};
 use crate::summary::MethodSummary;
 use crate::truth::{EtaKind, HCI_GT_FILE, Reference, SceneTruth};
+use lfformat::dataset::SceneDir;
+use lfformat::views::{LightField, centre_view};
 
 /// A progress bar on stderr, hidden when `quiet` (indicatif also hides it off a terminal).
 pub fn progress(len: usize, message: &str, quiet: bool) -> ProgressBar {

@@ -6,6 +6,7 @@
 //! them unchanged; the multimodal files (`modes.exr`, `gt_mpi_lowres.npz`) carry every depth
 //! that contributes to a pixel, and `manifest.json` ties a dataset's scenes together.
 
+pub mod dataset;
 pub mod error;
 pub mod files;
 pub mod lock;
@@ -14,6 +15,7 @@ pub mod modes;
 pub mod mpi;
 pub mod params;
 pub mod pfm;
+pub mod views;
 
 pub use error::{Error, Result};
 pub use modes::{Mode, ModeMap};

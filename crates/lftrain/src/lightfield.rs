@@ -9,9 +9,9 @@
 use std::path::Path;
 
 use anyhow::{Result, bail};
-use lfeval::baseline::views::{ViewSet, read_rgb};
-use lfeval::dataset::PARAMETERS_FILE;
 use lfformat::HciParameters;
+use lfformat::dataset::PARAMETERS_FILE;
+use lfformat::views::{ViewSet, read_rgb};
 
 /// The star views of a square `n × n` camera grid.
 #[derive(Clone, Debug, PartialEq)]

@@ -10,7 +10,7 @@ use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::thread::JoinHandle;
 
 use anyhow::{Context, Result, bail};
-use lfeval::dataset::SceneDir;
+use lfformat::dataset::SceneDir;
 use rand::RngExt;
 use rand_pcg::Pcg32;
 use rayon::prelude::*;

@@ -193,7 +193,7 @@ pub fn predict_dataset_over(
     let state = run.state()?;
     let device = crate::train::default_device();
     let net = run.load_net(&cfg, state.grid, &device)?.valid();
-    let scenes = lfeval::dataset::discover(dataset, &[])?;
+    let scenes = lfformat::dataset::discover(dataset, &[])?;
     let bar = lfeval::pipeline::progress(scenes.len(), "predicting", quiet);
     for s in &scenes {
         let lf = LightField::load(&s.path)?;

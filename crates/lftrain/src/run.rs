@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use burn::optim::ModuleOptimizer;
 use burn::prelude::*;
-use lfeval::dataset::{PARAMETERS_FILE, SceneDir};
 use lfformat::HciParameters;
+use lfformat::dataset::{PARAMETERS_FILE, SceneDir};
 use serde::{Deserialize, Serialize};
 
 use crate::config::{ModelKind, TrainConfig};

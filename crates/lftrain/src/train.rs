@@ -8,7 +8,7 @@ use anyhow::{Context, Result, bail};
 use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
 use burn::prelude::*;
 use indicatif::{ProgressBar, ProgressStyle};
-use lfeval::dataset::discover;
+use lfformat::dataset::discover;
 
 use crate::config::{ModelKind, TrainConfig};
 use crate::loader::{Loader, PoolConfig, TrainBatch};

@@ -3,11 +3,11 @@
 
 use anyhow::Result;
 use burn::prelude::*;
-use lfeval::dataset::SceneDir;
 use lfeval::metrics::kld::KldSums;
 use lfeval::scene_eval::{EvalConfig, PreparedTruth, evaluate};
 use lfeval::summary::mean;
 use lfeval::truth::{Reference, SceneTruth};
+use lfformat::dataset::SceneDir;
 use rayon::prelude::*;
 use serde::Serialize;
 

@@ -5,8 +5,8 @@
 
 use rayon::prelude::*;
 
-use super::views::LightField;
 use crate::bins::Bins;
+use lfformat::views::LightField;
 
 /// One cost slice per bin centre, each `width × height` row-major: `[k][y * width + x]`.
 pub fn cost_volume(lf: &LightField, bins: &Bins) -> Vec<Vec<f32>> {
@@ -115,7 +115,7 @@ fn window_means(values: impl Iterator<Item = f32>, len: usize, r: usize) -> Vec<
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::baseline::views::View;
+    use lfformat::views::View;
 
     #[test]
     fn shift_moves_by_whole_and_fractional_pixels_with_clamping() {

@@ -4,7 +4,6 @@
 //! softmax of the negative cost with a temperature, and a winner-take-all point estimate.
 
 pub mod cost;
-pub mod views;
 
 use std::time::Instant;
 
@@ -16,7 +15,7 @@ use crate::bins::Bins;
 use crate::posterior::{PosteriorForm, PosteriorMap};
 use crate::prediction::{ScenePrediction, point_estimates};
 use cost::{box_filter, cost_volume};
-use views::{LightField, ViewSet};
+use lfformat::views::{LightField, ViewSet};
 
 /// Settings of the baseline.
 #[derive(Clone, Debug, PartialEq, Serialize)]

@@ -11,10 +11,10 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
-use crate::dataset::SceneDir;
 use crate::prediction::Method;
 use crate::scene_eval::{EvalConfig, SceneScores};
 use crate::summary::MethodSummary;
+use lfformat::dataset::SceneDir;
 use samples::PosteriorSample;
 
 /// Folder of the per-scene BadPix maps, one sub-folder per method.

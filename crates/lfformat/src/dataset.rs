@@ -7,8 +7,8 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
-use lfformat::manifest::{Manifest, verify_scene_entry};
+use crate::manifest::{Manifest, verify_scene_entry};
+use crate::{Error, Result};
 
 /// The file that marks a scene folder.
 pub const PARAMETERS_FILE: &str = "parameters.cfg";
@@ -28,7 +28,7 @@ pub struct SceneDir {
 /// those split folders (an error if one does not exist).
 pub fn discover(root: &Path, splits: &[String]) -> Result<Vec<SceneDir>> {
     if !root.is_dir() {
-        bail!("{}: dataset folder does not exist", root.display());
+        return Err(Error::format(root, "dataset folder does not exist"));
     }
     let scenes = if is_scene(root) {
         reject_splits(root, splits)?;
@@ -43,12 +43,12 @@ pub fn discover(root: &Path, splits: &[String]) -> Result<Vec<SceneDir>> {
         }
     };
     if scenes.is_empty() {
-        bail!(
-            "{}: no scene folders (folders with {PARAMETERS_FILE}) found",
-            root.display()
-        );
+        return Err(Error::format(
+            root,
+            format!("no scene folders (folders with {PARAMETERS_FILE}) found"),
+        ));
     }
-    check_unique(&scenes)?;
+    check_unique(root, &scenes)?;
     verify_against_manifest(root, &scenes)?;
     Ok(scenes)
 }
@@ -83,12 +83,14 @@ fn verify_against_manifest(root: &Path, scenes: &[SceneDir]) -> Result<()> {
             .scenes
             .iter()
             .find(|e| e.dir == rel)
-            .with_context(|| {
-                format!(
-                    "{}: not listed in {} (a stray or unfinished scene): remove it, or complete \
-                 the dataset with lfgen --resume",
-                    scene.path.display(),
-                    manifest_path.display()
+            .ok_or_else(|| {
+                Error::format(
+                    &scene.path,
+                    format!(
+                        "not listed in {} (a stray or unfinished scene): remove it, or \
+                         complete the dataset with lfgen --resume",
+                        manifest_path.display()
+                    ),
                 )
             })?;
         verify_scene_entry(dataset, entry)?;
@@ -107,7 +109,7 @@ fn from_splits(root: &Path, splits: &[String]) -> Result<Vec<SceneDir>> {
     }
     for s in splits {
         if !root.join(s).is_dir() {
-            bail!("{}: no split folder {s:?}", root.display());
+            return Err(Error::format(root, format!("no split folder {s:?}")));
         }
     }
     Ok(scenes)
@@ -116,10 +118,10 @@ fn from_splits(root: &Path, splits: &[String]) -> Result<Vec<SceneDir>> {
 /// `--split` only makes sense for a folder of split folders.
 fn reject_splits(root: &Path, splits: &[String]) -> Result<()> {
     if !splits.is_empty() {
-        bail!(
-            "{}: --split given, but this folder holds scenes, not split folders",
-            root.display()
-        );
+        return Err(Error::format(
+            root,
+            "--split given, but this folder holds scenes, not split folders",
+        ));
     }
     Ok(())
 }
@@ -135,8 +137,7 @@ fn scene_children(dir: &Path, split: Option<String>) -> Result<Vec<SceneDir>> {
 
 /// Visible sub-folders of `dir`, sorted (hidden ones are partial lfgen output).
 fn sorted_subdirs(dir: &Path) -> Result<Vec<PathBuf>> {
-    let entries =
-        std::fs::read_dir(dir).with_context(|| format!("{}: cannot list", dir.display()))?;
+    let entries = std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))?;
     let mut dirs: Vec<PathBuf> = entries
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.is_dir() && !file_name(p).starts_with('.'))
@@ -165,14 +166,17 @@ fn file_name(p: &Path) -> String {
 }
 
 /// Predictions are keyed by scene name, so two scenes may not share one.
-fn check_unique(scenes: &[SceneDir]) -> Result<()> {
+fn check_unique(root: &Path, scenes: &[SceneDir]) -> Result<()> {
     let mut names: Vec<&str> = scenes.iter().map(|s| s.name.as_str()).collect();
     names.sort_unstable();
     if let Some(w) = names.windows(2).find(|w| w[0] == w[1]) {
-        bail!(
-            "two scenes are called {:?}; pick one split with --split",
-            w[0]
-        );
+        return Err(Error::format(
+            root,
+            format!(
+                "two scenes are called {:?}; pick one split with --split",
+                w[0]
+            ),
+        ));
     }
     Ok(())
 }
@@ -243,7 +247,7 @@ mod tests {
 
     #[test]
     fn a_manifest_is_verified_and_unlisted_scenes_are_refused() {
-        use lfformat::manifest::{FileEntry, SceneEntry, sha256_file};
+        use crate::manifest::{FileEntry, SceneEntry, sha256_file};
         let d = tempfile::tempdir().unwrap();
         let r = d.path();
         let scene = r.join("val/scene_0000");

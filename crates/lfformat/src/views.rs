@@ -1,16 +1,15 @@
-//! The views a baseline reads and how they are loaded.
+//! The views of a scene folder (`input_CamNNN.png`) as RGB in `[0, 1]`: the reader that
+//! evaluation baselines and training share.
 
 use std::path::Path;
 
-use anyhow::{Context, Result, bail};
-use clap::ValueEnum;
-use lfformat::HciParameters;
 use serde::Serialize;
 
 use crate::dataset::PARAMETERS_FILE;
+use crate::{Error, HciParameters, Result};
 
-/// Which views of the grid enter the photo-consistency cost.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, ValueEnum)]
+/// A subset of the view grid (the views a cost volume or a network reads).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ViewSet {
     /// The centre row and column (9 + 8 views of 9×9, the thesis' chapter 4 setup).
@@ -19,6 +18,19 @@ pub enum ViewSet {
     Star,
     /// Every view.
     Full,
+}
+
+impl std::str::FromStr for ViewSet {
+    type Err = String;
+
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "cross" => Ok(Self::Cross),
+            "star" => Ok(Self::Star),
+            "full" => Ok(Self::Full),
+            _ => Err(format!("{s:?}: expected cross, star or full")),
+        }
+    }
 }
 
 impl ViewSet {
@@ -71,10 +83,10 @@ impl LightField {
         let params = HciParameters::read(&dir.join(PARAMETERS_FILE))?;
         let (nx, ny) = (params.num_cams_x as usize, params.num_cams_y as usize);
         if nx % 2 == 0 || ny % 2 == 0 {
-            bail!(
-                "{}: the camera grid {nx}x{ny} has no centre view",
-                dir.display()
-            );
+            return Err(Error::format(
+                dir,
+                format!("the camera grid {nx}x{ny} has no centre view"),
+            ));
         }
         let (width, height) = (
             params.image_resolution_x_px as usize,
@@ -110,15 +122,17 @@ pub fn centre_view(dir: &Path) -> Result<(Vec<f32>, usize, usize)> {
 /// An 8-bit (or 16-bit) image as RGB in `[0, 1]`, checked against the expected size.
 pub fn read_rgb(path: &Path, width: usize, height: usize) -> Result<Vec<f32>> {
     let img = image::open(path)
-        .with_context(|| format!("{}: cannot read image", path.display()))?
+        .map_err(|e| Error::format(path, format!("cannot read image: {e}")))?
         .into_rgb32f();
     if (img.width() as usize, img.height() as usize) != (width, height) {
-        bail!(
-            "{}: {}x{} pixels, parameters.cfg says {width}x{height}",
-            path.display(),
-            img.width(),
-            img.height()
-        );
+        return Err(Error::format(
+            path,
+            format!(
+                "{}x{} pixels, parameters.cfg says {width}x{height}",
+                img.width(),
+                img.height()
+            ),
+        ));
     }
     Ok(img.into_raw())
 }
@@ -129,6 +143,13 @@ mod tests {
 
     #[test]
     fn view_sets_of_a_9x9_grid() {
+        assert_eq!("star".parse::<ViewSet>(), Ok(ViewSet::Star));
+        assert!(
+            "diagonal"
+                .parse::<ViewSet>()
+                .unwrap_err()
+                .contains("cross, star or full")
+        );
         let cross = ViewSet::Cross.positions(9, 9);
         assert_eq!(cross.len(), 17);
         assert!(cross.contains(&(4, 4)) && cross.contains(&(0, 4)) && cross.contains(&(4, 8)));
