@@ -7,6 +7,7 @@
 
 use crate::camera::LightFieldCamera;
 use crate::output::images::ToneCurve;
+pub use crate::render::slices::SliceAssignment;
 pub use crate::scene::SliceSpacing;
 use crate::scene::{MAX_GRID, MAX_SLICES};
 use anyhow::{Context, Result, bail};
@@ -141,17 +142,6 @@ pub enum GtViews {
     All,
 }
 
-/// Which depth decides a hit's slice.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum SliceAssignment {
-    /// The depth of the hit's surface (its triangle's plane) at the pixel centre: a continuous
-    /// surface is never cut by a slice boundary inside a pixel.
-    Surface,
-    /// The sample's own hit depth: literal camera-side clipping, as in the thesis.
-    Sample,
-}
-
 /// How the light leaving a surface is estimated across the views of a light field.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -180,7 +170,8 @@ pub struct RenderConfig {
     pub slice_assignment: SliceAssignment,
     /// A slice is a mode when its η (or η_exact) exceeds this.
     pub mode_epsilon: f64,
-    /// Shade every slice and write `slices.exr` (centre view); costs a shading per hit.
+    /// Shade every hit of the GT rays, so the MPI layers (`gt_mpi_lowres.npz`) carry true
+    /// slice colours; costs a shading per hit. (The renderer calls it `shade_all_hits`.)
     pub write_slices: bool,
     /// Also write linear `input_CamNNN.exr`.
     pub write_exr: bool,

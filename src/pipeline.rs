@@ -28,8 +28,7 @@ pub struct RenderJob {
     pub tone_curve: ToneCurve,
     /// Shade every hit of GT rays (true slice colours).
     pub shade_all_hits: bool,
-    /// Slice hits by their surface's depth at the pixel centre.
-    pub slice_by_surface: bool,
+    pub slice_assignment: SliceAssignment,
     /// Choose the exposure from the centre view (else keep the scene's).
     pub auto_exposure: bool,
     /// Date written into parameters.cfg.
@@ -56,7 +55,7 @@ impl RenderJob {
             write_exr: r.write_exr,
             tone_curve: r.tone_curve,
             shade_all_hits: r.write_slices,
-            slice_by_surface: r.slice_assignment == SliceAssignment::Surface,
+            slice_assignment: r.slice_assignment,
             auto_exposure: r.auto_exposure,
             date: date.to_string(),
             shading: r.shading,
@@ -91,7 +90,7 @@ impl RenderJob {
             scene_index: desc.index,
             mode_epsilon: self.mode_epsilon,
             shade_all_hits: self.shade_all_hits,
-            slice_by_surface: self.slice_by_surface,
+            slice_assignment: self.slice_assignment,
         }
     }
 }

@@ -10,6 +10,7 @@ use glam::{DVec3, Quat, Vec3};
 use lfformat::{Mode, ModeMap};
 use lfgen::camera::LightFieldCamera;
 use lfgen::output::images::{linear_to_srgb, to_srgb8};
+use lfgen::render::slices::SliceAssignment;
 use lfgen::render::view::ViewGt;
 use lfgen::scene::{Material, SceneDesc, Shape, SurfaceModel, Texture, Transform};
 
@@ -545,7 +546,7 @@ fn closed_room_eta_sums_to_one_and_modes_sorted() {
     };
     let by_surface = short(&g);
     let mut literal = settings(16, 2);
-    literal.slice_by_surface = false;
+    literal.slice_assignment = SliceAssignment::Sample;
     let by_sample = short(&gt(h.render(cam.center_view(), &literal, true)));
     let total = g.modes.width * g.modes.height;
     assert!(
@@ -588,7 +589,7 @@ fn slanted_plane_is_one_mode_with_surface_slicing() {
         );
     }
     let mut literal = settings(16, 1);
-    literal.slice_by_surface = false;
+    literal.slice_assignment = SliceAssignment::Sample;
     let g = gt(h.render(cam.center_view(), &literal, true));
     let split = pixels(&g.modes)
         .filter(|&(x, y)| g.modes.pixel(x, y).len() >= 2)

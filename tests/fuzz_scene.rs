@@ -12,6 +12,7 @@ mod mutate;
 use lfgen::config::Config;
 use lfgen::render::RenderScene;
 use lfgen::render::integrator::PathSettings;
+use lfgen::render::slices::SliceAssignment;
 use lfgen::render::view::RenderSettings;
 use lfgen::scene::SceneDesc;
 use lfgen::scene::assets::Assets;
@@ -75,7 +76,7 @@ fn run_in_process(v: Value) -> Outcome {
         scene_index: 0,
         mode_epsilon: 0.01,
         shade_all_hits: false,
-        slice_by_surface: true,
+        slice_assignment: SliceAssignment::Surface,
     };
     let center = desc.camera.center_view();
     let out = scene.render_view(

@@ -11,6 +11,7 @@ use lfformat::Mode;
 use lfgen::config::{BaselineMode, Config, SliceSpacing};
 use lfgen::render::RenderScene;
 use lfgen::render::integrator::PathSettings;
+use lfgen::render::slices::SliceAssignment;
 use lfgen::render::view::{RenderSettings, ViewGt, ViewOutput};
 use lfgen::scene::gltf::import;
 use lfgen::scene::{Light, SceneDesc, SliceRange, SurfaceModel};
@@ -80,7 +81,7 @@ impl Loaded {
             scene_index: 0,
             mode_epsilon: 1e-4,
             shade_all_hits: false,
-            slice_by_surface: true,
+            slice_assignment: SliceAssignment::Surface,
         };
         let cam = &self.desc.camera;
         let view = cam.center_view();

@@ -46,6 +46,7 @@ use lfgen::export::extract::ExportScene;
 use lfgen::pipeline::RenderJob;
 use lfgen::render::RenderScene;
 use lfgen::render::geometry::Hit;
+use lfgen::render::slices::SliceAssignment;
 use lfgen::render::view::RenderSettings;
 use lfgen::scene::assets::Assets;
 use lfgen::scene::{SceneDesc, SliceRange};
@@ -511,13 +512,13 @@ fn slice_renders_composited_with_over_match_the_single_pass_ground_truth() {
         );
         (out.gt.expect("the view's ground truth").modes, t.elapsed())
     };
-    assert!(!settings.slice_by_surface);
+    assert_eq!(settings.slice_assignment, SliceAssignment::Sample);
     let (sample_modes, lfgen_time) = render(&settings);
     assert!(
         sample_modes == written,
         "the in-process pass differs from modes.exr"
     );
-    settings.slice_by_surface = true;
+    settings.slice_assignment = SliceAssignment::Surface;
     let (surface_modes, _) = render(&settings);
     let sample = slice_etas(&written, &desc.slices, true);
     let surface = slice_etas(&surface_modes, &desc.slices, false);

@@ -9,6 +9,18 @@
 
 use glam::Vec3;
 use lfformat::Mode;
+use serde::{Deserialize, Serialize};
+
+/// Which depth decides a hit's slice.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SliceAssignment {
+    /// The depth of the hit's surface (its triangle's plane) at the pixel centre: a continuous
+    /// surface is never cut by a slice boundary inside a pixel.
+    Surface,
+    /// The sample's own hit depth: literal camera-side clipping, as in the thesis.
+    Sample,
+}
 
 /// One surface along a sample ray: its slice, planar depth and coverage in [0, 1].
 #[derive(Clone, Copy, Debug)]

@@ -6,7 +6,7 @@ use super::cache::{CacheGrid, CacheSums, RadianceCache};
 use super::geometry::Hit;
 use super::integrator::{PathSettings, Shading};
 use super::sampler::{RayKey, Sampler};
-use super::slices::{SliceAccumulator, SliceHit};
+use super::slices::{SliceAccumulator, SliceAssignment, SliceHit};
 use crate::camera::{CameraRay, LightFieldCamera, ViewRays};
 use crate::scene::SliceRange;
 use glam::Vec3;
@@ -25,8 +25,7 @@ pub struct RenderSettings {
     /// Shade every hit of GT rays, so mode colours are true slice colours (else each sample's
     /// colour goes to the slice of the surface it saw).
     pub shade_all_hits: bool,
-    /// Slice by the surface's depth at the pixel centre (else by the sample's hit depth).
-    pub slice_by_surface: bool,
+    pub slice_assignment: SliceAssignment,
 }
 
 /// Linear radiance, row-major from the top-left.
@@ -377,7 +376,7 @@ impl PixelCtx<'_> {
     /// at a crease inside the pixel, and the facets of a tessellated curve, stay one layer.
     /// Otherwise the hit depth itself decides (literal camera-side clipping).
     fn slice_of(&self, h: &Hit, origin: Vec3, centre_dir: Vec3, centre_hits: &[Hit]) -> u32 {
-        if !self.settings.slice_by_surface {
+        if self.settings.slice_assignment == SliceAssignment::Sample {
             return self.slices.index(h.t) as u32;
         }
         let geo = &self.scene.geometry;

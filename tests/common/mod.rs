@@ -10,6 +10,7 @@ use lfgen::config::SliceSpacing;
 use lfgen::render::RenderScene;
 use lfgen::render::cache::RadianceCache;
 use lfgen::render::integrator::{PathSettings, Shading};
+use lfgen::render::slices::SliceAssignment;
 use lfgen::render::view::{RenderSettings, ViewOutput};
 use lfgen::scene::{
     Material, Object, Opacity, SceneDesc, Shape, SliceRange, SurfaceModel, Texture, Transform,
@@ -152,7 +153,7 @@ pub fn settings(spp: u32, max_depth: u32) -> RenderSettings {
         scene_index: 0,
         mode_epsilon: 1e-4,
         shade_all_hits: false,
-        slice_by_surface: true,
+        slice_assignment: SliceAssignment::Surface,
     }
 }
 
