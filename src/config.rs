@@ -8,7 +8,10 @@
 use crate::camera::LightFieldCamera;
 use crate::output::images::ToneCurve;
 pub use crate::render::slices::SliceAssignment;
+use crate::scene::SliceRange;
 pub use crate::scene::SliceSpacing;
+pub use crate::scene::gltf::GltfSettings as GltfConfig;
+use crate::scene::gltf::ImportSettings;
 use crate::scene::{MAX_GRID, MAX_SLICES};
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
@@ -286,61 +289,16 @@ impl Default for SceneConfig {
     }
 }
 
-/// Rendering glTF 2.0 scenes (`lfgen render SCENE.gltf`).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct GltfConfig {
-    /// Which glTF scene: `"default"` (the file's `scene`, else its first), a scene name or an
-    /// index.
-    pub scene: String,
-    /// The centre view: `"first"` (the first perspective camera in node order), a camera or
-    /// camera-node name (`--camera NAME` sets this), or `"config"` for the pose below.
-    pub camera: String,
-    /// With `camera = "config"`: centre camera position, the point it looks at, the up hint
-    /// (metres, glTF world: +Y up) and the vertical field of view.
-    pub camera_position: [f64; 3],
-    pub camera_look_at: [f64; 3],
-    pub camera_up: [f64; 3],
-    pub camera_yfov_deg: f64,
-    /// Environment radiance (linear RGB) of a scene with lights (punctual or emissive).
-    pub environment: [f64; 3],
-    /// Environment radiance of a scene without any light: a uniform white sky, so that an
-    /// unlit export still renders.
-    pub unlit_environment: [f64; 3],
-}
-
-impl Default for GltfConfig {
-    fn default() -> Self {
-        Self {
-            scene: "default".into(),
-            camera: "first".into(),
-            camera_position: [0.0, 1.0, 3.0],
-            camera_look_at: [0.0, 1.0, 0.0],
-            camera_up: [0.0, 1.0, 0.0],
-            camera_yfov_deg: 40.0,
-            environment: [0.0, 0.0, 0.0],
-            unlit_environment: [1.0, 1.0, 1.0],
+impl Config {
+    /// What the glTF importer takes from this configuration.
+    pub fn gltf_import(&self) -> ImportSettings<'_> {
+        ImportSettings {
+            gltf: &self.gltf,
+            rig: self.camera.rig(),
+            seed: self.dataset.seed,
+            slices: SliceRange::unframed(self.render.slices, self.render.slice_spacing),
+            exposure: self.render.exposure as f32,
         }
-    }
-}
-
-impl GltfConfig {
-    fn validate(&self) -> Result<()> {
-        let finite = |v: &[f64; 3]| v.iter().all(|x| x.is_finite());
-        let vectors = [self.camera_position, self.camera_look_at, self.camera_up];
-        let fov = self.camera_yfov_deg;
-        if !(vectors.iter().all(finite) && fov > 0.0 && fov < 180.0) {
-            bail!("gltf camera pose must be finite and camera_yfov_deg in (0, 180)");
-        }
-        let radiance = [self.environment, self.unlit_environment];
-        if radiance
-            .iter()
-            .flatten()
-            .any(|v| !(v.is_finite() && *v >= 0.0))
-        {
-            bail!("gltf.environment and gltf.unlit_environment must be finite and non-negative");
-        }
-        Ok(())
     }
 }
 

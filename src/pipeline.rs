@@ -237,7 +237,7 @@ pub fn render_file(
 /// Imports a glTF scene, frames its camera grid (baseline and focus per `cfg.camera`) and
 /// writes it as a scene folder, like a generated scene.
 pub fn render_gltf(cfg: &Config, gltf: &Path, out: &Path, quiet: bool) -> Result<()> {
-    let imported = crate::scene::gltf::import(gltf, cfg)?;
+    let imported = crate::scene::gltf::import(gltf, &cfg.gltf_import())?;
     for w in &imported.warnings {
         eprintln!("warning: {}: {w}", gltf.display());
     }

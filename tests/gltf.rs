@@ -54,7 +54,8 @@ struct Loaded {
 }
 
 fn load(name: &str, cfg: &Config) -> Loaded {
-    let imported = import(&fixture(name), cfg).unwrap_or_else(|e| panic!("{name}: {e:#}"));
+    let imported =
+        import(&fixture(name), &cfg.gltf_import()).unwrap_or_else(|e| panic!("{name}: {e:#}"));
     let desc = SceneDesc {
         slices: SliceRange {
             z_near: 1.0,
@@ -209,20 +210,27 @@ fn node_hierarchy_with_rotation_scale_and_matrix_places_the_quad() {
 fn camera_is_chosen_by_name_and_a_missing_one_is_named() {
     let mut cfg = config([16, 16]);
     cfg.gltf.camera = "offset".into();
-    let d = import(&fixture("hierarchy.gltf"), &cfg).unwrap().desc;
+    let d = import(&fixture("hierarchy.gltf"), &cfg.gltf_import())
+        .unwrap()
+        .desc;
     assert!((d.camera.position - DVec3::new(0.25, 0.0, 0.0)).length() < 1e-7);
     cfg.gltf.camera = "nope".into();
     let err = format!(
         "{:#}",
-        import(&fixture("hierarchy.gltf"), &cfg).err().unwrap()
+        import(&fixture("hierarchy.gltf"), &cfg.gltf_import())
+            .err()
+            .unwrap()
     );
     assert!(err.contains("\"nope\"") && err.contains("offset"), "{err}");
     // A file without a camera needs one from the config.
     let err = format!(
         "{:#}",
-        import(&fixture("hostile/no_camera.gltf"), &config([16, 16]))
-            .err()
-            .unwrap()
+        import(
+            &fixture("hostile/no_camera.gltf"),
+            &config([16, 16]).gltf_import()
+        )
+        .err()
+        .unwrap()
     );
     assert!(
         err.contains("no camera") && err.contains("gltf.camera=config"),
@@ -231,7 +239,7 @@ fn camera_is_chosen_by_name_and_a_missing_one_is_named() {
     cfg.gltf.camera = "config".into();
     cfg.gltf.camera_position = [0.0, 0.0, 1.0];
     cfg.gltf.camera_look_at = [0.0, 0.0, -2.0];
-    let d = import(&fixture("hostile/no_camera.gltf"), &cfg)
+    let d = import(&fixture("hostile/no_camera.gltf"), &cfg.gltf_import())
         .unwrap()
         .desc;
     assert_eq!(d.camera.position, DVec3::new(0.0, 0.0, 1.0));
@@ -335,7 +343,7 @@ fn hostile_files_are_rejected_with_errors_naming_the_problem() {
     let cfg = config([16, 16]);
     for (name, needle) in cases {
         let path = fixture(&format!("hostile/{name}"));
-        let err = match import(&path, &cfg) {
+        let err = match import(&path, &cfg.gltf_import()) {
             Ok(_) => panic!("{name} was accepted"),
             Err(e) => format!("{e:#}"),
         };
@@ -367,7 +375,9 @@ fn ignored_extensions_and_maps_and_an_aspect_mismatch_are_warned_once() {
         .push(serde_json::json!(2));
     let path = tmp.path().join("warn.gltf");
     fs::write(&path, json.to_string()).unwrap();
-    let warnings = import(&path, &config([24, 20])).unwrap().warnings;
+    let warnings = import(&path, &config([24, 20]).gltf_import())
+        .unwrap()
+        .warnings;
     assert_eq!(warnings.len(), 3, "{warnings:#?}");
     assert_eq!(warnings[0], "extensions ignored: KHR_materials_clearcoat");
     assert!(
@@ -440,7 +450,7 @@ fn images_naming_one_file_are_decoded_once_and_the_total_is_bounded() {
             "mask.png",
         ],
     );
-    let imported = import(&same, &config([24, 20])).unwrap();
+    let imported = import(&same, &config([24, 20]).gltf_import()).unwrap();
     assert_eq!(
         imported.assets.image_bytes(),
         one,
@@ -458,7 +468,7 @@ fn images_naming_one_file_are_decoded_once_and_the_total_is_bounded() {
     assert!(Assets::from_files_within(&imported.desc, &files, one).is_ok());
 
     let two = many_images(tmp.path(), &["mask.png", "copy.png"]);
-    let imported = import(&two, &config([24, 20])).unwrap();
+    let imported = import(&two, &config([24, 20]).gltf_import()).unwrap();
     assert_eq!(imported.assets.image_bytes(), 2 * one);
     let files = open(&imported.desc);
     let err = Assets::from_files_within(&imported.desc, &files, one + one / 2)
@@ -516,7 +526,7 @@ fn materials_emission_glass_and_alpha_modes_convert_as_specified() {
     ]);
     let path = tmp.path().join("materials.gltf");
     fs::write(&path, json.to_string()).unwrap();
-    let d = import(&path, &config([16, 16])).unwrap().desc;
+    let d = import(&path, &config([16, 16]).gltf_import()).unwrap().desc;
     // Emission = factor × strength × the texture's mean linear colour (texels (200, 60, 40)
     // and (40, 60, 200)).
     let mean = |a: u8, b: u8| (srgb(a) + srgb(b)) / 2.0;

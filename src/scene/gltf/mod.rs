@@ -12,13 +12,14 @@ mod accessor;
 mod material;
 mod mesh;
 mod nodes;
+mod settings;
 mod source;
 
+pub use settings::{GltfSettings, ImportSettings};
 pub use source::GltfFile;
 
 use super::assets::{Assets, Source};
-use super::{Material, SceneDesc, SliceRange};
-use crate::config::Config;
+use super::{Material, SceneDesc};
 use anyhow::{Context, Result};
 use std::path::Path;
 
@@ -30,30 +31,30 @@ pub struct Imported {
     pub warnings: Vec<String>,
 }
 
-/// Reads `path` with the `[gltf]` and `[camera]` settings of `cfg`. The camera's baseline and
-/// focus and the slice range are provisional until the renderer frames the scene.
-pub fn import(path: &Path, cfg: &Config) -> Result<Imported> {
-    import_file(path, cfg).with_context(|| path.display().to_string())
+/// Reads `path` with `settings`. The camera's baseline and focus and the slice range are
+/// provisional until the renderer frames the scene.
+pub fn import(path: &Path, settings: &ImportSettings) -> Result<Imported> {
+    import_file(path, settings).with_context(|| path.display().to_string())
 }
 
-fn import_file(path: &Path, cfg: &Config) -> Result<Imported> {
+fn import_file(path: &Path, s: &ImportSettings) -> Result<Imported> {
     let file = GltfFile::open(path)?;
     let mut notes = Notes::default();
     let ignored = file.unsupported_extensions();
     if !ignored.is_empty() {
         notes.add(format!("extensions ignored: {}", ignored.join(", ")));
     }
-    let scene = nodes::pick_scene(&file, &cfg.gltf.scene)?;
+    let scene = nodes::pick_scene(&file, &s.gltf.scene)?;
     let placed = nodes::flatten(&file, &scene)?;
     let converted = material::materials(&file, 0, &mut notes)?;
     let mut materials = converted.list;
     let objects = nodes::objects(&placed, &converted.uv_sets, &mut materials, &mut notes);
     let lights = nodes::lights(&placed)?;
-    let camera = nodes::camera(&placed, cfg, &mut notes)?;
+    let camera = nodes::camera(&placed, s.gltf, &s.rig, &mut notes)?;
     let lit = !lights.is_empty() || materials.iter().any(Material::is_emissive);
     let environment = match lit {
-        true => cfg.gltf.environment,
-        false => cfg.gltf.unlit_environment,
+        true => s.gltf.environment,
+        false => s.gltf.unlit_environment,
     };
     let name = path
         .file_stem()
@@ -62,11 +63,11 @@ fn import_file(path: &Path, cfg: &Config) -> Result<Imported> {
         generator: format!("lfgen {}", env!("CARGO_PKG_VERSION")),
         name,
         index: 0,
-        seed: cfg.dataset.seed,
+        seed: s.seed,
         camera,
-        slices: SliceRange::unframed(cfg.render.slices, cfg.render.slice_spacing),
+        slices: s.slices,
         environment: environment.map(|v| v as f32),
-        exposure: cfg.render.exposure as f32,
+        exposure: s.exposure,
         materials,
         objects,
         lights,

@@ -3,9 +3,9 @@
 
 use super::Notes;
 use super::material::default_material;
+use super::settings::GltfSettings;
 use super::source::GltfFile;
 use crate::camera::LightFieldCamera;
-use crate::config::Config;
 use crate::scene::{Light, Material, Object, Shape, Transform};
 use ::gltf::camera::Projection;
 use ::gltf::khr_lights_punctual::Kind;
@@ -172,17 +172,15 @@ pub(super) fn lights(placed: &[Placed]) -> Result<Vec<Light>> {
 /// "config"), with the configured grid, resolution and sensor.
 pub(super) fn camera(
     placed: &[Placed],
-    cfg: &Config,
+    g: &GltfSettings,
+    rig: &LightFieldCamera,
     notes: &mut Notes,
 ) -> Result<LightFieldCamera> {
-    let g = &cfg.gltf;
     if g.camera == "config" {
         let position = DVec3::from(g.camera_position);
         let forward = DVec3::from(g.camera_look_at) - position;
         let yfov = g.camera_yfov_deg.to_radians();
-        return cfg
-            .camera
-            .rig()
+        return rig
             .looking(position, forward, DVec3::from(g.camera_up), yfov)
             .context("gltf.camera = \"config\"");
     }
@@ -206,7 +204,7 @@ pub(super) fn camera(
             p.label()
         );
     };
-    let [w, h] = cfg.camera.resolution;
+    let [w, h] = rig.resolution;
     let aspect = w as f64 / h as f64;
     if let Some(a) = persp
         .aspect_ratio()
@@ -223,9 +221,7 @@ pub(super) fn camera(
         -m.z_axis.truncate(),
         m.y_axis.truncate(),
     );
-    cfg.camera
-        .rig()
-        .looking(position, forward, up, persp.yfov() as f64)
+    rig.looking(position, forward, up, persp.yfov() as f64)
         .with_context(|| format!("camera on {}", p.label()))
 }
 
