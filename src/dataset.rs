@@ -14,7 +14,7 @@
 
 use crate::config::Config;
 use crate::pipeline::{RenderJob, generate_scene, render_scene};
-use crate::scene::library::AssetLibrary;
+use crate::procgen::library::AssetLibrary;
 use crate::stats::{DatasetSummary, SceneStats};
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};

@@ -12,6 +12,7 @@ pub mod dataset;
 pub mod export;
 pub mod output;
 pub mod pipeline;
+pub mod procgen;
 pub mod render;
 pub mod scene;
 pub mod stats;

@@ -4,13 +4,14 @@
 use crate::config::{BaselineMode, Config, GtViews, ShadingMode, SliceAssignment};
 use crate::output::images::ToneCurve;
 use crate::output::scene_dir::{GtImages, SceneWriter};
+use crate::procgen::builtin;
+use crate::procgen::library::AssetLibrary;
 use crate::render::RenderScene;
 use crate::render::framing::auto_exposure;
 use crate::render::integrator::{PathSettings, Shading};
 use crate::render::view::{RenderSettings, ViewOutput};
+use crate::scene::SceneDesc;
 use crate::scene::assets::Assets;
-use crate::scene::library::AssetLibrary;
-use crate::scene::{SceneDesc, builtin};
 use crate::stats::SceneStats;
 use anyhow::{Context, Result, bail};
 use lfformat::manifest::FileEntry;

@@ -3,7 +3,7 @@
 //! Nothing here depends on time or threads, so `stats.json` is as reproducible as the images;
 //! render timings go to the dataset's `timings.jsonl` instead.
 
-use crate::scene::placement::PlacementReport;
+use crate::scene::PlacementReport;
 use lfformat::ModeMap;
 use serde::{Deserialize, Serialize};
 

@@ -9,12 +9,13 @@ mod bin;
 use bin::{lfgen, ok, stderr};
 use glam::{Vec2, Vec3};
 use lfgen::config::Config;
+use lfgen::procgen::builtin;
+use lfgen::procgen::library::AssetLibrary;
 use lfgen::scene::assets::Assets;
-use lfgen::scene::library::AssetLibrary;
 use lfgen::scene::obj::ObjFile;
 use lfgen::scene::shapes::tessellate;
 use lfgen::scene::texture_image::srgb_to_linear;
-use lfgen::scene::{Opacity, Shape, Texture, builtin};
+use lfgen::scene::{Opacity, Shape, Texture};
 use std::path::{Path, PathBuf};
 
 fn fixtures() -> PathBuf {

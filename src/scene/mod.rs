@@ -8,16 +8,11 @@
 //! holding them; [`assets::Assets`] loads what a description refers to.
 
 pub mod assets;
-pub mod builtin;
 pub mod files;
-pub mod furniture;
 pub mod gltf;
-pub mod library;
 pub mod light;
 pub mod material;
 pub mod obj;
-pub mod openings;
-pub mod placement;
 pub mod shapes;
 pub mod texture_image;
 mod validate;
@@ -52,7 +47,7 @@ pub struct SceneDesc {
     pub lights: Vec<Light>,
     /// How the built-in generator's placement went (absent for imported scenes).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub placement: Option<placement::PlacementReport>,
+    pub placement: Option<PlacementReport>,
     /// Files that [`Shape::Mesh`] and image textures refer to (imported scenes).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub sources: Vec<SourceFile>,
@@ -102,6 +97,25 @@ pub const MAX_SLICES: u32 = 4096;
 /// Most triangles a scene may have after instancing (a bound on memory: ~0.4 KB each with
 /// the BVH).
 pub const MAX_TRIANGLES: usize = 20_000_000;
+
+/// Counts of the placement, recorded in `scene.json` and `stats.json`.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct PlacementReport {
+    /// Pieces drawn from the library.
+    pub requested: u32,
+    pub placed: u32,
+    /// Pieces for which no free, in-room, in-view spot was found.
+    pub rejected: u32,
+    /// Of the placed, how many stand on another piece.
+    pub on_top: u32,
+    /// Of the placed, how many come from the asset catalogue (`scene.catalog`).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub from_catalog: u32,
+}
+
+fn is_zero(n: &u32) -> bool {
+    *n == 0
+}
 
 /// The depth range `[z_near, z_far]` cut into `count` slices.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]

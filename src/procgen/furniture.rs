@@ -10,7 +10,7 @@
 //! [`Piece::style`]; together with the kind and a size class they define a *variant*, and the
 //! tests count the distinct variants the library produces.
 
-use super::{Shape, Transform};
+use crate::scene::{Shape, Transform};
 use glam::{Quat, Vec2, Vec3};
 use rand::RngExt;
 use rand_pcg::Pcg32;

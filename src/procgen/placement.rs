@@ -5,8 +5,8 @@
 //! World frame of the built-in rooms: floor at y = 0, x ∈ [−W/2, W/2], z ∈ [−D/2, D/2], the
 //! camera near +D/2 looking towards −Z.
 
+pub use crate::scene::PlacementReport;
 use glam::{Vec2, Vec3};
-use serde::{Deserialize, Serialize};
 
 /// An oriented rectangle on the floor plan (x, z): `centre`, half extents along the piece's
 /// local X and Z, and the yaw that turned it (as [`glam::Quat::from_rotation_y`]).
@@ -117,25 +117,6 @@ pub struct Layout {
     pub surfaces: Vec<WorldSurface>,
     /// Free space kept between pieces (metres).
     pub gap: f32,
-}
-
-/// Counts of the placement, recorded in `scene.json` and `stats.json`.
-#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub struct PlacementReport {
-    /// Pieces drawn from the library.
-    pub requested: u32,
-    pub placed: u32,
-    /// Pieces for which no free, in-room, in-view spot was found.
-    pub rejected: u32,
-    /// Of the placed, how many stand on another piece.
-    pub on_top: u32,
-    /// Of the placed, how many come from the asset catalogue (`scene.catalog`).
-    #[serde(default, skip_serializing_if = "is_zero")]
-    pub from_catalog: u32,
-}
-
-fn is_zero(n: &u32) -> bool {
-    *n == 0
 }
 
 impl Layout {

@@ -5,9 +5,9 @@
 //! to the catalogue's real size, so `scene.json` stays small and re-renderable.
 
 use super::furniture::{Part, Piece, Placement, Surface};
-use super::obj::ObjFile;
-use super::{Material, Opacity, Shape, SourceFile, Texture, Transform};
 use crate::catalog::{Asset, AssetPlacement, LoadedCatalog};
+use crate::scene::obj::ObjFile;
+use crate::scene::{Material, Opacity, Shape, SourceFile, Texture, Transform};
 use anyhow::{Result, bail};
 use glam::{Mat3, Mat4, Vec2, Vec3};
 use rayon::prelude::*;

@@ -11,12 +11,12 @@ use super::furniture::{self, Kind, MaterialSource, Piece, Placement, Role};
 use super::library::AssetLibrary;
 use super::openings::{Opening, OpeningKind, REVEAL, skirting_runs};
 use super::placement::{Body, Footprint, Layer, Layout, PlacementReport, WorldSurface};
-use super::{
+use crate::camera::LightFieldCamera;
+use crate::config::Config;
+use crate::scene::{
     Material, Object, Opacity, SceneDesc, Shape, SliceRange, SourceFile, SurfaceModel, Texture,
     Transform,
 };
-use crate::camera::LightFieldCamera;
-use crate::config::Config;
 use crate::textures::generators::{FAMILIES, Family};
 use crate::util::colour::luminance;
 use crate::util::hash::mix64;

@@ -1,0 +1,15 @@
+//! The procedural generator: random rooms with openings, furniture (built-in pieces and
+//! catalogue assets), placement, materials and lights, written as a [`SceneDesc`] that the
+//! renderer frames and renders. Nothing here renders or writes files.
+//!
+//! [`builtin`] draws one room; [`furniture`] builds pieces from primitives, [`library`] from
+//! an asset catalogue; [`placement`] keeps them apart and in view; [`openings`] cuts doors and
+//! windows.
+//!
+//! [`SceneDesc`]: crate::scene::SceneDesc
+
+pub mod builtin;
+pub mod furniture;
+pub mod library;
+pub mod openings;
+pub mod placement;
