@@ -103,7 +103,7 @@ pub fn generate_scene(
     index: u64,
     library: Option<&AssetLibrary>,
 ) -> Result<(SceneDesc, RenderScene)> {
-    let mut desc = builtin::generate(cfg, index, library);
+    let mut desc = builtin::generate(&cfg.scene, &cfg.scene_start(), index, library);
     desc.validate()
         .context("the generator made an invalid scene")?;
     let assets = Assets::load(&desc)?;

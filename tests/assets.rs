@@ -125,7 +125,12 @@ fn pieces_take_the_catalogue_size_and_rotation() {
     let extent = |i: usize| {
         let piece = lib.piece(i, 0, &mut |_| 0);
         let desc_sources = [lib.source(i).clone()];
-        let mut desc = builtin::generate(&Config::default(), 0, None);
+        let mut desc = builtin::generate(
+            &Config::default().scene,
+            &Config::default().scene_start(),
+            0,
+            None,
+        );
         desc.sources = desc_sources.to_vec();
         desc.objects.clear();
         for p in &piece.parts {
@@ -181,8 +186,11 @@ fn scenes_with_catalogue_pieces_stay_inside_the_room_and_are_deterministic() {
     let mut from_catalog = 0;
     for seed in 0..8 {
         let cfg = catalog_config(seed);
-        let desc = builtin::generate(&cfg, seed, Some(&lib));
-        assert_eq!(desc, builtin::generate(&cfg, seed, Some(&lib)));
+        let desc = builtin::generate(&cfg.scene, &cfg.scene_start(), seed, Some(&lib));
+        assert_eq!(
+            desc,
+            builtin::generate(&cfg.scene, &cfg.scene_start(), seed, Some(&lib))
+        );
         let report = desc.placement.clone().unwrap();
         from_catalog += report.from_catalog;
         let meshes = desc
@@ -229,7 +237,7 @@ fn scenes_with_catalogue_pieces_stay_inside_the_room_and_are_deterministic() {
     // Without a catalogue the procedural scenes are exactly those of the generator alone.
     let plain = Config::default();
     assert_eq!(
-        builtin::generate(&plain, 2, None)
+        builtin::generate(&plain.scene, &plain.scene_start(), 2, None)
             .placement
             .unwrap()
             .from_catalog,

@@ -11,10 +11,10 @@ use super::furniture::{self, Kind, MaterialSource, Piece, Placement, Role};
 use super::library::AssetLibrary;
 use super::openings::{Opening, OpeningKind, REVEAL, skirting_runs};
 use super::placement::{Body, Footprint, Layer, Layout, PlacementReport, WorldSurface};
+use super::settings::RoomSettings;
 use crate::camera::LightFieldCamera;
-use crate::config::Config;
 use crate::scene::{
-    Material, Object, Opacity, SceneDesc, Shape, SliceRange, SourceFile, SurfaceModel, Texture,
+    Material, Object, Opacity, SceneDesc, SceneStart, Shape, SourceFile, SurfaceModel, Texture,
     Transform,
 };
 use crate::textures::generators::{FAMILIES, Family};
@@ -40,19 +40,26 @@ const TRIES: u32 = 60;
 /// Skirting board height and thickness.
 const SKIRTING: [f32; 2] = [0.08, 0.015];
 
-/// Generates scene `index` of the dataset described by `cfg`. The camera's baseline, focus and
-/// the slice range are provisional until the renderer frames the scene.
-pub fn generate(cfg: &Config, index: u64, library: Option<&AssetLibrary>) -> SceneDesc {
+/// Generates scene `index` of a dataset: a room drawn by `room`, starting from `start`. The
+/// camera's baseline, focus and the slice range are provisional until the renderer frames the
+/// scene.
+pub fn generate(
+    room: &RoomSettings,
+    start: &SceneStart,
+    index: u64,
+    library: Option<&AssetLibrary>,
+) -> SceneDesc {
     let mut g = Gen {
-        rng: Pcg32::new(mix64(cfg.dataset.seed ^ mix64(index)), 0x5CE7E),
-        cfg,
+        rng: Pcg32::new(mix64(start.seed ^ mix64(index)), 0x5CE7E),
+        room,
+        rig: &start.rig,
         library,
         materials: Vec::new(),
         objects: Vec::new(),
         sources: Vec::new(),
         openings: Vec::new(),
     };
-    let s = &cfg.scene;
+    let s = room;
     let size = Vec3::new(
         g.range(s.room_width),
         g.range(s.room_height),
@@ -66,11 +73,11 @@ pub fn generate(cfg: &Config, index: u64, library: Option<&AssetLibrary>) -> Sce
         generator: format!("lfgen {}", env!("CARGO_PKG_VERSION")),
         name: format!("scene_{index:04}"),
         index,
-        seed: cfg.dataset.seed,
+        seed: start.seed,
         camera,
-        slices: SliceRange::unframed(cfg.render.slices, cfg.render.slice_spacing),
+        slices: start.slices,
         environment: s.environment.map(|v| v as f32),
-        exposure: cfg.render.exposure as f32,
+        exposure: start.exposure,
         materials: g.materials,
         objects: g.objects,
         lights: Vec::new(),
@@ -81,7 +88,9 @@ pub fn generate(cfg: &Config, index: u64, library: Option<&AssetLibrary>) -> Sce
 
 struct Gen<'a> {
     rng: Pcg32,
-    cfg: &'a Config,
+    room: &'a RoomSettings,
+    /// The camera rig the room's camera aims.
+    rig: &'a LightFieldCamera,
     library: Option<&'a AssetLibrary>,
     materials: Vec<Material>,
     objects: Vec<Object>,
@@ -146,9 +155,9 @@ impl Gen<'_> {
             .iter()
             .position(|&x| x == family)
             .expect("a family") as u32;
-        let per_family = (self.cfg.scene.textures / FAMILIES.len() as u32).max(1);
+        let per_family = (self.room.textures / FAMILIES.len() as u32).max(1);
         Texture::Library {
-            seed: self.cfg.scene.texture_seed,
+            seed: self.room.texture_seed,
             index: f + FAMILIES.len() as u32 * self.rng.random_range(0..per_family),
             tint: [1.0; 3],
         }
@@ -282,7 +291,7 @@ impl Gen<'_> {
         {
             return self.push_material(m);
         }
-        let s = &self.cfg.scene;
+        let s = self.room;
         let (glass, semi, cutout, range) = (s.glass, s.semi_transparent, s.cutout, s.opacity_range);
         if self.chance(glass) {
             return self.glass(&m.name);
@@ -451,7 +460,7 @@ impl Gen<'_> {
     /// Up to `scene.windows` windows and, by chance `scene.door`, a door in the back wall,
     /// at random places that keep apart.
     fn draw_openings(&mut self, size: Vec3) -> Vec<Opening> {
-        let s = &self.cfg.scene;
+        let s = self.room;
         let (door, [lo, hi]) = (s.door, s.windows);
         let mut wanted = Vec::new();
         if self.chance(door) {
@@ -512,7 +521,7 @@ impl Gen<'_> {
     /// sideways per metre).
     fn outdoors(&mut self, o: &Opening, z: f32) {
         let kelvin = self.between(5500.0, 7500.0);
-        let sky = Vec3::from(kelvin_rgb(kelvin)) * self.range(self.cfg.scene.window_light);
+        let sky = Vec3::from(kelvin_rgb(kelvin)) * self.range(self.room.window_light);
         let face = z - REVEAL;
         let dist = self.between(1.4, 2.2);
         // Half the extent seen around the window at `d` beyond the wall's outer face.
@@ -772,7 +781,7 @@ impl Gen<'_> {
 
     /// Ceiling area lights along the room, of random colour temperature and intensity.
     fn lights(&mut self, size: Vec3) {
-        let n = self.cfg.scene.lights;
+        let n = self.room.lights;
         for i in 0..n {
             let kelvin = self.between(2700.0, 6500.0);
             let power = 6.0 + 10.0 * self.unit();
@@ -801,7 +810,7 @@ impl Gen<'_> {
 
     /// The centre camera: near the front wall at eye height, looking into the room.
     fn camera(&mut self, size: Vec3) -> LightFieldCamera {
-        let rig = self.cfg.camera.rig();
+        let rig = self.rig.clone();
         let yaw = (self.unit() - 0.5) * 0.2;
         let pitch = -0.1 - 0.12 * self.unit();
         let forward =
@@ -826,8 +835,8 @@ impl Gen<'_> {
         let kinds: Vec<f32> = Kind::ALL.iter().map(|k| k.weight()).collect();
         let assets = self
             .library
-            .map(|lib| lib.weights(&self.cfg.scene.category_weights));
-        let mut picks: Vec<Pick> = (0..self.cfg.scene.objects)
+            .map(|lib| lib.weights(&self.room.category_weights));
+        let mut picks: Vec<Pick> = (0..self.room.objects)
             .map(|_| self.pick(&kinds, assets.as_deref()))
             .collect();
         picks.sort_by_key(|&p| self.placement_of(p) == Placement::OnTop);
@@ -867,7 +876,7 @@ impl Gen<'_> {
     /// entries (computed once per scene).
     fn pick(&mut self, kinds: &[f32], assets: Option<&[f32]>) -> Pick {
         if let Some(weights) = assets
-            && self.chance(self.cfg.scene.catalog_share)
+            && self.chance(self.room.catalog_share)
         {
             return Pick::Asset(self.weighted(weights).unwrap_or(0));
         }
@@ -1136,8 +1145,8 @@ fn kelvin_rgb(kelvin: f32) -> [f32; 3] {
 mod tests {
     use super::*;
 
-    fn cfg(seed: u64) -> Config {
-        let mut c = Config::default();
+    fn cfg(seed: u64) -> crate::config::Config {
+        let mut c = crate::config::Config::default();
         c.dataset.seed = seed;
         c
     }
@@ -1150,7 +1159,8 @@ mod tests {
             let c = cfg(seed);
             let mut g = Gen {
                 rng: Pcg32::new(mix64(seed), 1),
-                cfg: &c,
+                room: &c.scene,
+                rig: &c.camera.rig(),
                 library: None,
                 materials: Vec::new(),
                 objects: Vec::new(),
@@ -1197,9 +1207,9 @@ mod tests {
     #[test]
     fn scenes_are_deterministic_per_seed_and_index_and_report_placement() {
         let c = cfg(5);
-        let a = generate(&c, 3, None);
-        assert_eq!(a, generate(&c, 3, None));
-        assert_ne!(a, generate(&c, 4, None));
+        let a = generate(&c.scene, &c.scene_start(), 3, None);
+        assert_eq!(a, generate(&c.scene, &c.scene_start(), 3, None));
+        assert_ne!(a, generate(&c.scene, &c.scene_start(), 4, None));
         let r = a.placement.clone().unwrap();
         assert_eq!(r.requested, c.scene.objects);
         assert_eq!(r.placed + r.rejected, r.requested);
@@ -1225,7 +1235,7 @@ mod tests {
         use crate::scene::assets::Assets;
         use crate::scene::shapes::tessellate;
         for seed in 0..12 {
-            let desc = generate(&cfg(seed), seed, None);
+            let desc = generate(&cfg(seed).scene, &cfg(seed).scene_start(), seed, None);
             let room = desc
                 .objects
                 .iter()
@@ -1263,7 +1273,7 @@ mod tests {
     fn windows_look_out_on_textured_layers_at_several_depths() {
         let mut windows = 0;
         for seed in 0..20 {
-            let desc = generate(&cfg(seed), seed, None);
+            let desc = generate(&cfg(seed).scene, &cfg(seed).scene_start(), seed, None);
             let wall = desc.objects.iter().find(|o| o.name == "wall_back").unwrap();
             let z_wall = wall.transform.translation.z;
             let outside: Vec<_> = (desc.objects.iter())
@@ -1299,7 +1309,7 @@ mod tests {
         use crate::scene::shapes::tessellate;
         let (mut windows, mut doors) = (0, 0);
         for seed in 0..20 {
-            let desc = generate(&cfg(seed), seed, None);
+            let desc = generate(&cfg(seed).scene, &cfg(seed).scene_start(), seed, None);
             let wall = desc.objects.iter().find(|o| o.name == "wall_back").unwrap();
             let (Shape::Wall { size, holes }, z) = (&wall.shape, wall.transform.translation.z)
             else {

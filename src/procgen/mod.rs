@@ -13,3 +13,4 @@ pub mod furniture;
 pub mod library;
 pub mod openings;
 pub mod placement;
+pub mod settings;

@@ -117,6 +117,17 @@ fn is_zero(n: &u32) -> bool {
     *n == 0
 }
 
+/// What a new scene description starts with, from the caller's settings: the camera rig (the
+/// scene's builder aims it), the dataset seed, the slice count and spacing (their range is
+/// provisional until the renderer frames the scene) and the exposure.
+#[derive(Clone, Debug)]
+pub struct SceneStart {
+    pub rig: LightFieldCamera,
+    pub seed: u64,
+    pub slices: SliceRange,
+    pub exposure: f32,
+}
+
 /// The depth range `[z_near, z_far]` cut into `count` slices.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -50,7 +50,7 @@ fn import_file(path: &Path, s: &ImportSettings) -> Result<Imported> {
     let mut materials = converted.list;
     let objects = nodes::objects(&placed, &converted.uv_sets, &mut materials, &mut notes);
     let lights = nodes::lights(&placed)?;
-    let camera = nodes::camera(&placed, s.gltf, &s.rig, &mut notes)?;
+    let camera = nodes::camera(&placed, s.gltf, &s.start.rig, &mut notes)?;
     let lit = !lights.is_empty() || materials.iter().any(Material::is_emissive);
     let environment = match lit {
         true => s.gltf.environment,
@@ -63,11 +63,11 @@ fn import_file(path: &Path, s: &ImportSettings) -> Result<Imported> {
         generator: format!("lfgen {}", env!("CARGO_PKG_VERSION")),
         name,
         index: 0,
-        seed: s.seed,
+        seed: s.start.seed,
         camera,
-        slices: s.slices,
+        slices: s.start.slices,
         environment: environment.map(|v| v as f32),
-        exposure: s.exposure,
+        exposure: s.start.exposure,
         materials,
         objects,
         lights,

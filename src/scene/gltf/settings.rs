@@ -1,8 +1,7 @@
 //! The importer's own parameters (the `[gltf]` section of `generator.toml`) and everything else
 //! an import needs from the caller, so that the import layer reads no CLI configuration.
 
-use crate::camera::LightFieldCamera;
-use crate::scene::SliceRange;
+use crate::scene::SceneStart;
 use anyhow::{Result, bail};
 use serde::{Deserialize, Serialize};
 
@@ -65,14 +64,10 @@ impl GltfSettings {
     }
 }
 
-/// What an import takes besides the file: the `[gltf]` settings, the camera rig (image, grid,
-/// sensor; the importer aims it), and the values a new scene description starts with.
+/// What an import takes besides the file: the `[gltf]` settings and what the new scene
+/// description starts with (the importer aims the rig at the file's camera).
 #[derive(Clone, Debug)]
 pub struct ImportSettings<'a> {
     pub gltf: &'a GltfSettings,
-    pub rig: LightFieldCamera,
-    pub seed: u64,
-    /// Count and spacing; the range is provisional until the renderer frames the scene.
-    pub slices: SliceRange,
-    pub exposure: f32,
+    pub start: SceneStart,
 }
