@@ -1,8 +1,11 @@
 //! lfgen: multimodal light-field depth datasets.
 //!
-//! Data flows one way: [`config`] → [`scene`] (a re-renderable description) → [`render`]
-//! (colour and 128-slice ground truth in memory) → [`output`] (scene folders) → [`dataset`]
-//! (many scenes, shards, manifest). [`pipeline`] drives one scene through those stages.
+//! Data flows one way. From the bottom: [`util`] (hashing, colour) → [`camera`], [`textures`]
+//! → [`scene`] (the re-renderable description and its import) → [`procgen`] (random rooms) and
+//! [`render`] (colour and 128-slice ground truth in memory) → [`output`] (scene folders),
+//! [`export`], [`stats`] → [`config`] (the CLI's settings, mapped onto each layer's own) →
+//! [`pipeline`] (one scene through those stages) → [`dataset`] (many scenes, shards, manifest).
+//! `tests/layers.rs` keeps every module from naming a layer above it.
 
 pub mod bench;
 pub mod camera;
