@@ -1,7 +1,7 @@
 //! The built-in procedural scene generator: a deep closed room — floor, walls and ceiling
 //! textured from the procedural texture library at their real tile sizes, skirting, ceiling
 //! lights of random colour temperature — furnished with pieces of the procedural furniture
-//! library ([`furniture`]) placed without collisions ([`placement`]) where the narrow HCI lens
+//! library ([`furniture`]) placed without collisions ([`placement`](super::placement)) where the narrow HCI lens
 //! sees them, plus accessories on their tops.
 //!
 //! Everything is drawn from one RNG stream per (seed, scene index), so a scene is a pure
