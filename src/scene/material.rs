@@ -70,7 +70,7 @@ pub enum Texture {
         seed: u32,
     },
     /// Texture `index` of the procedural library with master `seed`
-    /// ([`crate::textures::TextureSpec::from_index`]), tiling at its real size
+    /// ([`crate::textures::generators::TextureSpec::from_index`]), tiling at its real size
     /// (`tile_size_m` of the spec), times a linear `tint`. The renderer draws it into an image
     /// once per scene instead of evaluating the generator per hit; `scene.json` stays small.
     Library {
