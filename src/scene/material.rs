@@ -211,14 +211,7 @@ fn pick(a: [f32; 3], b: [f32; 3], t: f32) -> Vec3 {
 
 /// Smoothly interpolated lattice noise in [0, 1].
 fn value_noise(p: Vec2, seed: u32) -> f32 {
-    let cell = p.floor();
-    let f = p - cell;
-    let s = f * f * (Vec2::splat(3.0) - 2.0 * f);
-    let (i, j) = (cell.x as i32, cell.y as i32);
-    let h = |di: i32, dj: i32| lattice(i + di, j + dj, seed);
-    let top = h(0, 0) + (h(1, 0) - h(0, 0)) * s.x;
-    let bottom = h(0, 1) + (h(1, 1) - h(0, 1)) * s.x;
-    top + (bottom - top) * s.y
+    crate::textures::noise::interpolate(p.x, p.y, |i, j| lattice(i as i32, j as i32, seed))
 }
 
 fn lattice(i: i32, j: i32, seed: u32) -> f32 {

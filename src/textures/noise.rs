@@ -12,11 +12,21 @@ fn lattice(i: i64, j: i64, period: i64, seed: u64) -> f32 {
 /// Smooth value noise in [0, 1) at (u, v) ∈ [0, 1)², with `cells` lattice cells per tile side;
 /// periodic in u and v with period 1.
 pub fn value(u: f32, v: f32, cells: u32, seed: u64) -> f32 {
-    let (x, y) = (u * cells as f32, v * cells as f32);
+    let p = cells as i64;
+    interpolate(u * cells as f32, v * cells as f32, |i, j| {
+        lattice(i, j, p, seed)
+    })
+}
+
+/// Value noise at (x, y) from the lattice values `lattice(i, j)` at integer points:
+/// smoothstep-weighted bilinear interpolation of the four around (x, y). Every value noise of
+/// lfgen (the periodic tiles here, the scene description's `Texture::Noise`) is this with its
+/// own lattice hash.
+pub fn interpolate(x: f32, y: f32, lattice: impl Fn(i64, i64) -> f32) -> f32 {
     let (i, j) = (x.floor(), y.floor());
     let (fx, fy) = (smooth(x - i), smooth(y - j));
-    let (i, j, p) = (i as i64, j as i64, cells as i64);
-    let l = |di, dj| lattice(i + di, j + dj, p, seed);
+    let (i, j) = (i as i64, j as i64);
+    let l = |di, dj| lattice(i + di, j + dj);
     let top = l(0, 0) + (l(1, 0) - l(0, 0)) * fx;
     let bottom = l(0, 1) + (l(1, 1) - l(0, 1)) * fx;
     top + (bottom - top) * fy
