@@ -6,7 +6,7 @@
 
 use crate::camera::LightFieldCamera;
 use crate::scene::assets::Assets;
-use crate::scene::shapes::{MeshTri, tessellate};
+use crate::scene::shapes::MeshTri;
 use crate::scene::{Material, Opacity, SceneDesc, SurfaceModel, Texture};
 use anyhow::{Context, Result};
 use glam::{DVec3, Vec3};
@@ -137,23 +137,15 @@ impl<'a> ExportScene<'a> {
     /// Tessellates every object of `desc` and sets up the selected views.
     pub fn new(desc: &'a SceneDesc, assets: &Assets, views: &[u32]) -> Result<Self> {
         let mut meshes = Vec::with_capacity(desc.objects.len());
-        for (i, obj) in desc.objects.iter().enumerate() {
-            anyhow::ensure!(
-                (obj.material as usize) < desc.materials.len(),
-                "object {:?} refers to missing material {}",
-                obj.name,
-                obj.material
-            );
-            let mut tris = Vec::new();
-            tessellate(&obj.shape, &obj.transform, assets, &mut tris)
-                .with_context(|| format!("object {:?}", obj.name))?;
+        desc.for_each_mesh(assets, |i, obj, tris| {
             meshes.push(ExportMesh {
                 object: i,
                 id: format!("o{i}_{}", sanitize(&obj.name)),
                 material: obj.material,
-                tris,
+                tris: tris.to_vec(),
             });
-        }
+            Ok(())
+        })?;
         let cameras = views
             .iter()
             .map(|&v| ExportCamera::of(&desc.camera, v))

@@ -17,8 +17,7 @@
 use super::extract::{
     DepthVisibility, ExportCamera, ExportMesh, ExportScene, mean_color, mean_emission, mean_opacity,
 };
-use crate::scene::SliceSpacing;
-use crate::scene::{Light, Opacity, SliceRange, SurfaceModel};
+use crate::scene::{Light, Opacity, SurfaceModel};
 use anyhow::Result;
 use glam::{DVec3, Vec3};
 use std::fmt::Write as _;
@@ -217,23 +216,6 @@ fn cutout_shape(opacity: &Opacity) -> Option<(String, f32)> {
     }
 }
 
-/// The boundaries `z_0 < … < z_S` of the slices in planar depth, as
-/// [`SliceRange::index`] cuts them (equal steps in depth or in 1/depth).
-pub fn slice_boundaries(r: &SliceRange) -> Vec<f64> {
-    let n = r.count as f64;
-    (0..=r.count)
-        .map(|k| {
-            let s = k as f64 / n;
-            match r.spacing {
-                SliceSpacing::Depth => r.z_near + s * (r.z_far - r.z_near),
-                SliceSpacing::Disparity => {
-                    1.0 / (1.0 / r.z_near + s * (1.0 / r.z_far - 1.0 / r.z_near))
-                }
-            }
-        })
-        .collect()
-}
-
 /// One depth slice alone (the thesis' ground truth renders slice `k` by itself): every object
 /// is clipped to the planar-depth slab `[z_k, z_{k+1})` of the view's camera (the first and
 /// last slices extend to the camera and to infinity, as [`SliceRange::index`] clamps), shown
@@ -250,7 +232,7 @@ fn slice_scene(scene: &ExportScene) -> String {
     s.push_str("#include \"cameras.inc\"\n#include \"geometry.inc\"\n");
     s.push_str("#ifndef (Slice) #error \"declare the slice: Declare=Slice=K\" #end\n");
     let r = &scene.desc.slices;
-    let z: Vec<String> = slice_boundaries(r).iter().map(f64::to_string).collect();
+    let z: Vec<String> = r.boundaries().iter().map(f64::to_string).collect();
     let _ = writeln!(
         s,
         "#declare SliceCount = {};\n#declare SliceZ = array[{}] {{ {} }}",
@@ -457,30 +439,6 @@ mod tests {
         // up × forward in POV-Ray's, i.e. POV-Ray's left-handed convention.
         let (r, u, f) = (to_pov(cam.right()), to_pov(cam.up), to_pov(cam.forward));
         assert!((r - u.cross(f)).length() < 1e-12);
-    }
-
-    /// Every slab `[z_k, z_{k+1})` of `slices.pov` is the set of depths lfgen puts in slice k.
-    #[test]
-    fn slice_boundaries_cut_where_the_slice_index_changes() {
-        for spacing in [SliceSpacing::Depth, SliceSpacing::Disparity] {
-            let r = SliceRange {
-                z_near: 1.3,
-                z_far: 9.7,
-                count: 128,
-                spacing,
-            };
-            let z = slice_boundaries(&r);
-            assert_eq!(z.len(), 129);
-            assert!((z[0] - 1.3).abs() < 1e-12 && (z[128] - 9.7).abs() < 1e-9);
-            for k in 0..128 {
-                let (a, b) = (z[k], z[k + 1]);
-                assert!(a < b);
-                for t in [1e-5, 0.5, 1.0 - 1e-5] {
-                    let inside = (a + t * (b - a)) as f32;
-                    assert_eq!(r.index(inside), k, "{spacing:?} slice {k}");
-                }
-            }
-        }
     }
 
     #[test]

@@ -15,9 +15,8 @@ pub mod slices;
 pub mod view;
 
 use crate::scene::assets::Assets;
-use crate::scene::shapes::tessellate;
 use crate::scene::{MAX_TRIANGLES, SceneDesc};
-use anyhow::{Context, Result, bail, ensure};
+use anyhow::{Result, bail, ensure};
 use geometry::{Geometry, SceneTri};
 use glam::Vec3;
 use lights::{Lights, PunctualLight};
@@ -46,17 +45,7 @@ impl RenderScene {
             bail!("light {bad} has non-finite or negative values or a degenerate direction");
         }
         let mut tris = Vec::new();
-        let mut mesh = Vec::new();
-        for (i, obj) in desc.objects.iter().enumerate() {
-            ensure!(
-                (obj.material as usize) < desc.materials.len(),
-                "object {:?} refers to missing material {}",
-                obj.name,
-                obj.material
-            );
-            mesh.clear();
-            tessellate(&obj.shape, &obj.transform, assets, &mut mesh)
-                .with_context(|| format!("object {:?}", obj.name))?;
+        desc.for_each_mesh(assets, |i, obj, mesh| {
             ensure!(
                 tris.len() + mesh.len() <= MAX_TRIANGLES,
                 "the scene has more than {MAX_TRIANGLES} triangles (at object {:?})",
@@ -67,7 +56,8 @@ impl RenderScene {
                 material: obj.material,
                 object: i as u32,
             }));
-        }
+            Ok(())
+        })?;
         let names: Vec<String> = desc.objects.iter().map(|o| o.name.clone()).collect();
         // In parallel: library textures are drawn into tiles here.
         let materials = desc

@@ -150,6 +150,23 @@ impl SliceRange {
         }
     }
 
+    /// The boundaries `z_0 < … < z_S` of the slices in planar depth, as [`Self::index`] cuts
+    /// them (equal steps in depth or in 1/depth); the POV-Ray slice export clips by them.
+    pub fn boundaries(&self) -> Vec<f64> {
+        let n = self.count as f64;
+        (0..=self.count)
+            .map(|k| {
+                let s = k as f64 / n;
+                match self.spacing {
+                    SliceSpacing::Depth => self.z_near + s * (self.z_far - self.z_near),
+                    SliceSpacing::Disparity => {
+                        1.0 / (1.0 / self.z_near + s * (1.0 / self.z_far - 1.0 / self.z_near))
+                    }
+                }
+            })
+            .collect()
+    }
+
     /// Slice of planar depth `z`; depths outside the range go to the first / last slice.
     #[inline]
     pub fn index(&self, z: f32) -> usize {
@@ -165,6 +182,30 @@ impl SliceRange {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every slab `[z_k, z_{k+1})` is the set of depths `index` puts in slice k.
+    #[test]
+    fn slice_boundaries_cut_where_the_slice_index_changes() {
+        for spacing in [SliceSpacing::Depth, SliceSpacing::Disparity] {
+            let r = SliceRange {
+                z_near: 1.3,
+                z_far: 9.7,
+                count: 128,
+                spacing,
+            };
+            let z = r.boundaries();
+            assert_eq!(z.len(), 129);
+            assert!((z[0] - 1.3).abs() < 1e-12 && (z[128] - 9.7).abs() < 1e-9);
+            for k in 0..128 {
+                let (a, b) = (z[k], z[k + 1]);
+                assert!(a < b);
+                for t in [1e-5, 0.5, 1.0 - 1e-5] {
+                    let inside = (a + t * (b - a)) as f32;
+                    assert_eq!(r.index(inside), k, "{spacing:?} slice {k}");
+                }
+            }
+        }
+    }
 
     #[test]
     fn slice_index_in_depth_and_disparity_spacing() {

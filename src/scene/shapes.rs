@@ -2,8 +2,8 @@
 //! (imported meshes keep their own texture coordinates).
 
 use super::assets::{Assets, MeshKey};
-use super::{Shape, Transform};
-use anyhow::Result;
+use super::{Object, SceneDesc, Shape, Transform};
+use anyhow::{Context, Result, ensure};
 use glam::{Mat3, Mat4, Vec2, Vec3};
 use std::f32::consts::{PI, TAU};
 
@@ -13,6 +13,33 @@ pub struct MeshTri {
     pub p: [Vec3; 3],
     pub n: [Vec3; 3],
     pub uv: [Vec2; 3],
+}
+
+impl SceneDesc {
+    /// Tessellates the objects in order into world-space triangles and hands each to
+    /// `each(index, object, triangles)`, after checking its material index; errors name the
+    /// object. The renderer and the exporters both build from this, so they see the same
+    /// triangles and the same checks.
+    pub fn for_each_mesh(
+        &self,
+        assets: &Assets,
+        mut each: impl FnMut(usize, &Object, &[MeshTri]) -> Result<()>,
+    ) -> Result<()> {
+        let mut mesh = Vec::new();
+        for (i, obj) in self.objects.iter().enumerate() {
+            ensure!(
+                (obj.material as usize) < self.materials.len(),
+                "object {:?} refers to missing material {}",
+                obj.name,
+                obj.material
+            );
+            mesh.clear();
+            tessellate(&obj.shape, &obj.transform, assets, &mut mesh)
+                .with_context(|| format!("object {:?}", obj.name))?;
+            each(i, obj, &mesh)?;
+        }
+        Ok(())
+    }
 }
 
 /// Appends the triangles of `shape` placed by `xf` to `out`; a [`Shape::Mesh`] takes its
