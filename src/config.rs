@@ -84,7 +84,7 @@ pub enum BaselineMode {
     Fixed,
 }
 
-/// The light-field camera grid (HCI conventions, SPEC §2).
+/// The light-field camera grid (HCI conventions, docs/conventions.md).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct CameraConfig {

@@ -37,7 +37,7 @@ fn config(resolution: [u32; 2]) -> Config {
     cfg
 }
 
-/// Focal length in pixels from the fixture camera's yfov (SPEC: f_px = H/2 / tan(yfov/2)).
+/// Focal length in pixels from the fixture camera's yfov (glTF camera: f_px = H/2 / tan(yfov/2)).
 fn f_px(height: u32, yfov: f64) -> f64 {
     height as f64 / 2.0 / (yfov / 2.0).tan()
 }

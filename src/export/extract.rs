@@ -286,7 +286,7 @@ mod tests {
     }
 
     /// A point on the focus plane keeps its pixel in every view; others move by the view
-    /// offset times their disparity (SPEC §2).
+    /// offset times their disparity (docs/conventions.md, Camera).
     #[test]
     fn focus_plane_stays_in_register() {
         let mut cam = camera();

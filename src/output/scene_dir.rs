@@ -1,4 +1,4 @@
-//! One scene folder (SPEC §4), written atomically: into `.NAME.partial`, then renamed.
+//! One scene folder (docs/conventions.md, Scene folder), written atomically: into `.NAME.partial`, then renamed.
 //!
 //! While a scene is written its folder is locked (`.NAME.lock`, see [`Lock`]), so two runs
 //! never write into one partial folder. An existing folder at the final place is replaced only
@@ -273,7 +273,7 @@ pub fn list_files(dir: &Path, root: &Path) -> Result<Vec<FileEntry>> {
         .collect()
 }
 
-/// HCI `parameters.cfg` of a scene (SPEC §2, HCI.md).
+/// HCI `parameters.cfg` of a scene (docs/conventions.md, Scene folder).
 fn hci_parameters(desc: &SceneDesc, stats: &SceneStats) -> HciParameters {
     let cam = &desc.camera;
     let [px, py, pz] = cam.blender_position();
