@@ -86,48 +86,79 @@ pub struct BsdfSample {
 }
 
 impl SurfaceParams {
+    /// The BSDF at this hit, its per-hit constants (GGX α, Fresnel, the albedo-table row)
+    /// resolved once, as pbrt's `GetBSDF` does: a path vertex evaluates and samples it several
+    /// times (light samples, the continuation, the cache's split).
+    pub fn bsdf(&self) -> Bsdf {
+        Bsdf(match self.kind {
+            SurfaceKind::Standard => Model::Standard(StandardLobes::new(self)),
+            SurfaceKind::Glass { ior } => Model::Glass {
+                tint: self.base_color,
+                ior,
+            },
+        })
+    }
+}
+
+/// A hit's BSDF, ready to evaluate and sample ([`SurfaceParams::bsdf`]).
+pub struct Bsdf(Model);
+
+enum Model {
+    Standard(StandardLobes),
+    Glass { tint: Vec3, ior: f32 },
+}
+
+impl Bsdf {
     /// f(wo, wi) and the pdf with which `sample` would produce wi (0 for delta materials).
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
-        match self.kind {
-            SurfaceKind::Standard => StandardLobes::new(self).eval(wo, wi),
-            SurfaceKind::Glass { .. } => (Vec3::ZERO, 0.0),
+        match &self.0 {
+            Model::Standard(lobe) => lobe.eval(wo, wi),
+            Model::Glass { .. } => (Vec3::ZERO, 0.0),
         }
     }
 
     /// Sample wi given two uniform numbers; None when the sample is absorbed/invalid.
     /// `u_lobe` chooses the lobe, `u` the direction.
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
-        match self.kind {
-            SurfaceKind::Standard => StandardLobes::new(self).sample(wo, u_lobe, u),
-            SurfaceKind::Glass { ior } => sample_glass(self.base_color, ior, wo, u_lobe),
+        match &self.0 {
+            Model::Standard(lobe) => lobe.sample(wo, u_lobe, u),
+            Model::Glass { tint, ior } => sample_glass(*tint, *ior, wo, u_lobe),
         }
     }
 
     /// True when the material has no non-delta lobe (NEE is pointless).
     pub fn is_delta(&self) -> bool {
-        matches!(self.kind, SurfaceKind::Glass { .. })
+        matches!(self.0, Model::Glass { .. })
+    }
+
+    /// The Standard lobes, or `None` for a delta material.
+    fn standard(&self) -> Option<&StandardLobes> {
+        match &self.0 {
+            Model::Standard(lobe) => Some(lobe),
+            Model::Glass { .. } => None,
+        }
     }
 
     /// [`Self::eval`] restricted to `lobes` (see [`Lobes`]); delta materials give zero.
     pub fn eval_lobes(&self, wo: Vec3, wi: Vec3, lobes: Lobes) -> (Vec3, f32) {
-        match (lobes, self.kind) {
+        match (lobes, self.standard()) {
             (Lobes::All, _) => self.eval(wo, wi),
-            (_, SurfaceKind::Glass { .. }) => (Vec3::ZERO, 0.0),
-            (Lobes::Specular, _) => StandardLobes::new(self).specular_only(wo, wi),
-            (Lobes::CoupledIrradiance, _) => StandardLobes::new(self).coupling_in(wi),
+            (_, None) => (Vec3::ZERO, 0.0),
+            (Lobes::Specular, Some(lobe)) => lobe.specular_only(wo, wi),
+            (Lobes::CoupledIrradiance, Some(lobe)) => lobe.coupling_in(wi),
         }
     }
 
     /// [`Self::sample`] restricted to `lobes`: the glossy lobe by its visible normals, or the
     /// coupled-irradiance integrand by the cosine.
     pub fn sample_lobes(&self, wo: Vec3, u_lobe: f32, u: Vec2, lobes: Lobes) -> Option<BsdfSample> {
-        if lobes == Lobes::All || self.is_delta() || wo.z <= 0.0 {
-            return match lobes {
-                Lobes::All => self.sample(wo, u_lobe, u),
-                _ => None,
-            };
+        if lobes == Lobes::All {
+            return self.sample(wo, u_lobe, u);
         }
-        let lobe = StandardLobes::new(self);
+        let lobe = self.standard()?;
+        if wo.z <= 0.0 {
+            return None;
+        }
         let (wi, (f, pdf)) = match lobes {
             Lobes::Specular => {
                 let wi = reflect(wo, sample_ggx_vndf(wo, lobe.alpha, u));
@@ -149,21 +180,21 @@ impl SurfaceParams {
     /// The outgoing factor of the diffuse term, `ρ/π' · (1 − E(μo))`: the diffuse light
     /// leaving towards `wo` is this times the coupled irradiance (`render::cache`).
     pub fn diffuse_out(&self, wo: Vec3) -> Vec3 {
-        if self.is_delta() || wo.z <= 0.0 {
-            return Vec3::ZERO;
+        match self.standard() {
+            Some(_) if wo.z <= 0.0 => Vec3::ZERO,
+            Some(lobe) => lobe.diffuse * (1.0 - lobe.albedo_split(wo.z).dot(lobe.dielectric)),
+            None => Vec3::ZERO,
         }
-        let lobe = StandardLobes::new(self);
-        lobe.diffuse * (1.0 - lobe.albedo_split(wo.z).dot(lobe.dielectric))
     }
 
     /// The share of the glossy lobe in the light leaving towards `wo` (the probability with
     /// which [`Self::sample`] picks it); 0 for delta materials.
     pub fn specular_probability(&self, wo: Vec3) -> f32 {
-        if self.is_delta() || wo.z <= 0.0 {
-            return 0.0;
+        match self.standard() {
+            Some(_) if wo.z <= 0.0 => 0.0,
+            Some(lobe) => lobe.specular_probability(lobe.albedo_split(wo.z)),
+            None => 0.0,
         }
-        let lobe = StandardLobes::new(self);
-        lobe.specular_probability(lobe.albedo_split(wo.z))
     }
 }
 
@@ -644,7 +675,7 @@ mod tests {
     /// Monte-Carlo directional albedo `E[f cos / pdf]`, absorbed samples counting zero.
     fn albedo_mc(p: &SurfaceParams, wo: Vec3, n: usize, rng: &mut Rng) -> Vec3 {
         let sum: Vec3 = (0..n)
-            .filter_map(|_| p.sample(wo, rng.next(), rng.next2()))
+            .filter_map(|_| p.bsdf().sample(wo, rng.next(), rng.next2()))
             .map(|s| s.f * s.wi.z.abs() / s.pdf)
             .sum();
         sum / n as f32
@@ -686,7 +717,7 @@ mod tests {
         for roughness in [0.3, 0.7, 1.0] {
             for mu in [1.0, 0.5, 0.2] {
                 let p = standard(Vec3::ONE, roughness, 0.0);
-                let a = hemisphere_quadrature(|wi| p.eval(wo_at(mu), wi).0 * wi.z);
+                let a = hemisphere_quadrature(|wi| p.bsdf().eval(wo_at(mu), wi).0 * wi.z);
                 assert_close(a.x, 1.0, 0.01, &format!("r={roughness} mu={mu}"));
             }
         }
@@ -704,10 +735,10 @@ mod tests {
                 kind: SurfaceKind::Standard,
             };
             let wo = rng.upper();
-            let Some(s) = p.sample(wo, rng.next(), rng.next2()) else {
+            let Some(s) = p.bsdf().sample(wo, rng.next(), rng.next2()) else {
                 continue;
             };
-            let (f, pdf) = p.eval(wo, s.wi);
+            let (f, pdf) = p.bsdf().eval(wo, s.wi);
             assert!(!s.is_delta && s.wi.z > 0.0 && s.pdf > 0.0);
             assert_close(s.wi.length(), 1.0, 1e-4, "unit wi");
             assert_close(pdf, s.pdf, 1e-3, "pdf");
@@ -726,11 +757,11 @@ mod tests {
             for mu in [1.0, 0.5, 0.15] {
                 let wo = wo_at(mu);
                 let test_fn = |wi: Vec3| Vec3::new(wi.x, wi.z * wi.z, wi.x * wi.y + wi.z);
-                let integral = hemisphere_quadrature(|wi| Vec3::splat(p.eval(wo, wi).1)).x;
-                let expected = hemisphere_quadrature(|wi| test_fn(wi) * p.eval(wo, wi).1);
+                let integral = hemisphere_quadrature(|wi| Vec3::splat(p.bsdf().eval(wo, wi).1)).x;
+                let expected = hemisphere_quadrature(|wi| test_fn(wi) * p.bsdf().eval(wo, wi).1);
                 let n = 50_000;
                 let (mut accepted, mut mean) = (0usize, Vec3::ZERO);
-                for s in (0..n).filter_map(|_| p.sample(wo, rng.next(), rng.next2())) {
+                for s in (0..n).filter_map(|_| p.bsdf().sample(wo, rng.next(), rng.next2())) {
                     accepted += 1;
                     mean += test_fn(s.wi) / n as f32;
                 }
@@ -769,7 +800,7 @@ mod tests {
                 kind: SurfaceKind::Standard,
             };
             let (a, b) = (rng.upper(), rng.upper());
-            let (fab, fba) = (p.eval(a, b).0, p.eval(b, a).0);
+            let (fab, fba) = (p.bsdf().eval(a, b).0, p.bsdf().eval(b, a).0);
             for c in 0..3 {
                 assert_close(fab[c], fba[c], 1e-3, "reciprocity");
             }
@@ -787,7 +818,7 @@ mod tests {
             };
             for _ in 0..1000 {
                 let (wo, wi) = (rng.upper(), rng.upper());
-                let (f, pdf) = p.eval(wo, wi);
+                let (f, pdf) = p.bsdf().eval(wo, wi);
                 assert!((f - base / PI).abs().max_element() < 1e-6, "{f}");
                 assert_close(pdf, wi.z / PI, 1e-6, "cosine pdf");
             }
@@ -798,15 +829,15 @@ mod tests {
     fn standard_rejects_viewer_below_surface() {
         let p = standard(Vec3::ONE, 0.5, 0.0);
         let below = Vec3::new(0.6, 0.0, -0.8);
-        assert!(p.sample(below, 0.5, Vec2::splat(0.5)).is_none());
-        assert_eq!(p.eval(below, Vec3::Z).1, 0.0);
-        assert_eq!(p.eval(Vec3::Z, below), (Vec3::ZERO, 0.0));
-        assert!(!p.is_delta());
+        assert!(p.bsdf().sample(below, 0.5, Vec2::splat(0.5)).is_none());
+        assert_eq!(p.bsdf().eval(below, Vec3::Z).1, 0.0);
+        assert_eq!(p.bsdf().eval(Vec3::Z, below), (Vec3::ZERO, 0.0));
+        assert!(!p.bsdf().is_delta());
     }
 
     /// Reflectance of the glass seen from `wo`: the pdf of the reflection sample.
     fn glass_reflectance(ior: f32, wo: Vec3) -> f32 {
-        let s = glass(ior).sample(wo, 0.0, Vec2::ZERO).unwrap();
+        let s = glass(ior).bsdf().sample(wo, 0.0, Vec2::ZERO).unwrap();
         assert_eq!(s.wi, Vec3::new(-wo.x, -wo.y, wo.z));
         s.pdf
     }
@@ -826,14 +857,14 @@ mod tests {
         let theta = 60f32.to_radians();
         let wo = Vec3::new(theta.sin(), 0.0, -theta.cos());
         for u_lobe in [0.0, 0.5, 0.999_999, 1.0] {
-            let s = glass(1.5).sample(wo, u_lobe, Vec2::ZERO).unwrap();
+            let s = glass(1.5).bsdf().sample(wo, u_lobe, Vec2::ZERO).unwrap();
             assert_eq!(s.pdf, 1.0);
             assert!((s.wi - Vec3::new(-wo.x, 0.0, wo.z)).length() < 1e-6);
             assert_close(s.f.x * s.wi.z.abs() / s.pdf, 1.0, 1e-6, "TIR weight");
         }
         let theta = 40f32.to_radians();
         let wo = Vec3::new(theta.sin(), 0.0, -theta.cos());
-        assert!(glass(1.5).sample(wo, 0.99, Vec2::ZERO).unwrap().wi.z > 0.0);
+        assert!(glass(1.5).bsdf().sample(wo, 0.99, Vec2::ZERO).unwrap().wi.z > 0.0);
     }
 
     #[test]
@@ -842,7 +873,7 @@ mod tests {
         let mut refracted = 0;
         for _ in 0..2000 {
             let wo = rng.direction();
-            let s = glass(1.5).sample(wo, 0.999_9, Vec2::ZERO).unwrap();
+            let s = glass(1.5).bsdf().sample(wo, 0.999_9, Vec2::ZERO).unwrap();
             if s.wi.z * wo.z >= 0.0 {
                 continue;
             }
@@ -863,8 +894,9 @@ mod tests {
         for _ in 0..1000 {
             let wo = rng.direction();
             let p = glass(1.5);
-            let r = p.sample(wo, 0.0, Vec2::ZERO).unwrap();
+            let r = p.bsdf().sample(wo, 0.0, Vec2::ZERO).unwrap();
             let Some(t) = p
+                .bsdf()
                 .sample(wo, 1.0 - 1e-7, Vec2::ZERO)
                 .filter(|t| t.wi.z * wo.z < 0.0)
             else {
@@ -882,8 +914,8 @@ mod tests {
             );
             assert!(r.is_delta && t.is_delta);
         }
-        assert!(glass(1.5).is_delta());
-        assert_eq!(glass(1.5).eval(Vec3::Z, -Vec3::Z), (Vec3::ZERO, 0.0));
+        assert!(glass(1.5).bsdf().is_delta());
+        assert_eq!(glass(1.5).bsdf().eval(Vec3::Z, -Vec3::Z), (Vec3::ZERO, 0.0));
     }
 
     #[test]

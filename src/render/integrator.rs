@@ -114,7 +114,7 @@ impl RenderScene {
                 let cos = wo.dot(self.geometry.geometric_normal(h.tri)).abs();
                 len * settings.footprint / cos.max(0.05).sqrt()
             });
-            let bsdf = mat.surface_filtered(self.geometry.uv(&h), width);
+            let bsdf = mat.surface_filtered(self.geometry.uv(&h), width).bsdf();
             let frame = Frame::from_normal(self.shading_normal(&h, wo, mat.glass_ior.is_some()));
             let wo_l = frame.to_local(wo);
             let mut lobes = Lobes::All;
@@ -231,7 +231,7 @@ impl RenderScene {
         h: &Hit,
         frame: &Frame,
         wo_l: Vec3,
-        bsdf: &super::bsdf::SurfaceParams,
+        bsdf: &super::bsdf::Bsdf,
         (lobes, select): (Lobes, f32),
         sampler: &mut Sampler,
     ) -> Vec3 {
@@ -274,7 +274,7 @@ impl RenderScene {
         h: &Hit,
         frame: &Frame,
         wo_l: Vec3,
-        bsdf: &super::bsdf::SurfaceParams,
+        bsdf: &super::bsdf::Bsdf,
         lobes: Lobes,
     ) -> Vec3 {
         let mut sum = Vec3::ZERO;
