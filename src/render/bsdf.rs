@@ -25,7 +25,7 @@
 //! * Sampling: one lobe is picked with probability proportional to its directional albedo for
 //!   `wo`; the specular lobe samples visible normals (Heitz 2018, spherical-cap form of Dupuy &
 //!   Benyoub 2023), the diffuse lobe is cosine-weighted. The returned pdf is the one-sample mixture
-//!   `p_spec·pdf_spec + p_diff·pdf_diff`, which is also what [`SurfaceParams::eval`] returns.
+//!   `p_spec·pdf_spec + p_diff·pdf_diff`, which is also what [`Bsdf::eval`] returns.
 //!   Visible-normal samples that reflect below the horizon are rejected (`None`), so the pdf
 //!   integrates to the acceptance probability: below 1 for rough specular lobes (a pure GGX lobe
 //!   at normal incidence keeps `1/(1+α²)`, only 0.5 at roughness 1).
