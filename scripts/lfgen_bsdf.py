@@ -1,4 +1,4 @@
-"""lfgen's Standard BSDF (src/render/bsdf.rs) as a Mitsuba 3 plugin, for colour comparisons
+"""lfgen's Standard BSDF (crates/lfrender/src/bsdf.rs) as a Mitsuba 3 plugin, for colour comparisons
 with the same reflectance model (README, "Validation"; used by scripts/validate.py).
 
     import mitsuba as mi; mi.set_variant("llvm_ad_rgb")

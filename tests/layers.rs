@@ -1,12 +1,13 @@
-//! The layering of `src/` and `crates/lfscene/src/`, checked: each top-level module may name
+//! The layering of `src/`, `crates/lfscene/src/` and `crates/lfrender/src/`, checked: each top-level module may name
 //! (`crate::…`) only the modules below it, so data flows one way — util → camera, textures →
 //! scene (description and import) → procgen / render → output, export, stats → config →
 //! pipeline, dataset, bench.
 //!
-//! Why a test: the crate graph already keeps `lfscene` (util, camera, textures, scene) from
-//! naming anything of `lfgen`, but within one crate the compiler allows any path, so a backward
+//! Why a test: the crate graph already keeps `lfscene` (util, camera, textures, scene) and
+//! `lfrender` from naming anything of `lfgen`, and `lfscene` from naming the renderer, but
+//! within one crate the compiler allows any path, so a backward
 //! import would otherwise go unnoticed until it has grown into a cycle. `lfgen` re-exports
-//! lfscene's modules under the same names, so one table covers both crates. Test modules
+//! lfscene's modules and lfrender (as `render`) under the same names, so one table covers all. Test modules
 //! (after `#[cfg(test)]`) may use anything, as they build fixtures from the layers above.
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -88,6 +89,12 @@ fn no_module_names_a_layer_above_it() {
     for src in ["src", "crates/lfscene/src"] {
         visit(&root.join(src), None, &mut edges);
     }
+    // The renderer's crate is the `render` layer as a whole.
+    visit(
+        &root.join("crates/lfrender/src"),
+        Some("render"),
+        &mut edges,
+    );
     assert!(edges.len() > 20, "the scan found the imports: {edges:?}");
     let allowed: BTreeMap<&str, &[&str]> = ALLOWED.iter().copied().collect();
     let backward: Vec<String> = edges

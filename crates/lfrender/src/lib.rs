@@ -3,6 +3,10 @@
 //! It consumes a [`SceneDesc`] and produces images and mode maps in memory; it knows nothing about
 //! files.
 
+// The scene layer under the names the renderer's modules use (`crate::scene::…`), so the
+// renderer reads like the rest of lfgen; private, so they are not re-exported from here.
+use lfscene::{camera, scene, textures, util};
+
 pub mod bsdf;
 pub mod cache;
 pub mod framing;
