@@ -2,22 +2,23 @@
 //!
 //! Data flows one way. From the bottom: the `lfscene` crate, re-exported here under the same
 //! names — [`util`] (hashing, colour) → [`camera`], [`textures`] → [`scene`] (the
-//! re-renderable description and its import); then [`procgen`] (random rooms) and [`render`]
-//! (the `lfrender` crate: colour and 128-slice ground truth in memory) → [`output`] (scene
+//! re-renderable description and its import); then [`procgen`] (random rooms; the
+//! `lfprocgen` crate, drawing on the asset [`catalog`] of `lfassets`) and [`render`] (the
+//! `lfrender` crate: colour and 128-slice ground truth in memory) → [`output`] (scene
 //! folders), [`export`], [`stats`] → [`config`] (the CLI's settings, mapped onto each layer's
 //! own) → [`pipeline`] (one scene through those stages) → [`dataset`] (many scenes, shards,
 //! manifest). The crate graph and `tests/layers.rs` keep every module from naming a layer above
 //! it.
 
+pub use lfassets as catalog;
+pub use lfprocgen as procgen;
 pub use lfrender as render;
 pub use lfscene::{camera, scene, textures, util};
 
 pub mod bench;
-pub mod catalog;
 pub mod config;
 pub mod dataset;
 pub mod export;
 pub mod output;
 pub mod pipeline;
-pub mod procgen;
 pub mod stats;

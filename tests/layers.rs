@@ -1,13 +1,14 @@
-//! The layering of `src/`, `crates/lfscene/src/` and `crates/lfrender/src/`, checked: each top-level module may name
+//! The layering of `src/` and of the crates it is built on (lfscene, lfrender, lfprocgen,
+//! lfassets), checked: each top-level module may name
 //! (`crate::…`) only the modules below it, so data flows one way — util → camera, textures →
 //! scene (description and import) → procgen / render → output, export, stats → config →
 //! pipeline, dataset, bench.
 //!
-//! Why a test: the crate graph already keeps `lfscene` (util, camera, textures, scene) and
-//! `lfrender` from naming anything of `lfgen`, and `lfscene` from naming the renderer, but
-//! within one crate the compiler allows any path, so a backward
+//! Why a test: the crate graph already keeps those crates from naming anything of `lfgen` or of
+//! each other upwards, but within one crate the compiler allows any path, so a backward
 //! import would otherwise go unnoticed until it has grown into a cycle. `lfgen` re-exports
-//! lfscene's modules and lfrender (as `render`) under the same names, so one table covers all. Test modules
+//! lfscene's modules, lfrender (as `render`), lfprocgen (as `procgen`) and lfassets (as
+//! `catalog`) under the same names, so one table covers all. Test modules
 //! (after `#[cfg(test)]`) may use anything, as they build fixtures from the layers above.
 
 use std::collections::{BTreeMap, BTreeSet};

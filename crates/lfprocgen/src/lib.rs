@@ -8,6 +8,11 @@
 //!
 //! [`SceneDesc`]: crate::scene::SceneDesc
 
+// The layers below under the names the generator's modules use (`crate::scene::…`); private,
+// so they are not re-exported from here.
+use lfassets as catalog;
+use lfscene::{camera, scene, textures, util};
+
 pub mod builtin;
 pub mod furniture;
 pub mod library;

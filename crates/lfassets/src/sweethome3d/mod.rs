@@ -712,7 +712,7 @@ fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
 mod tests {
     use super::debian::PLUGIN_CATALOG;
     use super::*;
-    use crate::catalog::AssetPlacement;
+    use crate::AssetPlacement;
     use std::io::Write;
 
     /// A `.sh3f` written in the test, converted field by field.
@@ -785,7 +785,7 @@ mod tests {
         assert!(summary.nonfree.is_empty());
         assert!(!dir.path().join("evil.obj").exists());
 
-        let catalog = crate::catalog::LoadedCatalog::read(&out.join("catalog.json")).unwrap();
+        let catalog = crate::LoadedCatalog::read(&out.join("catalog.json")).unwrap();
         let assets = &catalog.catalog.assets;
         assert_eq!(assets.len(), 2);
         let chair = &assets[0];

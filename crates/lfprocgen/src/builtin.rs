@@ -1145,10 +1145,42 @@ fn kelvin_rgb(kelvin: f32) -> [f32; 3] {
 mod tests {
     use super::*;
 
-    fn cfg(seed: u64) -> crate::config::Config {
-        let mut c = crate::config::Config::default();
-        c.dataset.seed = seed;
-        c
+    /// lfgen's default `[scene]` settings, and what its default config starts a scene with
+    /// (the HCI rig: 512², 9×9 views, 100 mm lens on a 35 mm sensor, 50 mm baseline, focus at
+    /// 3 m; 128 depth slices; exposure 1), with dataset seed `seed`.
+    struct Cfg {
+        scene: RoomSettings,
+        start: SceneStart,
+    }
+
+    impl Cfg {
+        fn scene_start(&self) -> SceneStart {
+            self.start.clone()
+        }
+    }
+
+    fn cfg(seed: u64) -> Cfg {
+        let rig = LightFieldCamera {
+            resolution: [512, 512],
+            grid: [9, 9],
+            focal_length_mm: 100.0,
+            sensor_size_mm: 35.0,
+            baseline_m: 0.05,
+            focus_distance_m: 3.0,
+            position: DVec3::ZERO,
+            forward: DVec3::NEG_Z,
+            up: DVec3::Y,
+        };
+        let slices = crate::scene::SliceRange::unframed(128, crate::scene::SliceSpacing::Depth);
+        Cfg {
+            scene: RoomSettings::default(),
+            start: SceneStart {
+                rig,
+                seed,
+                slices,
+                exposure: 1.0,
+            },
+        }
     }
 
     /// Re-derives every placed piece's body from the scene's objects is not possible after
@@ -1160,7 +1192,7 @@ mod tests {
             let mut g = Gen {
                 rng: Pcg32::new(mix64(seed), 1),
                 room: &c.scene,
-                rig: &c.camera.rig(),
+                rig: &c.start.rig,
                 library: None,
                 materials: Vec::new(),
                 objects: Vec::new(),
