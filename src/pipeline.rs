@@ -243,8 +243,6 @@ pub fn render_gltf(cfg: &Config, gltf: &Path, out: &Path, quiet: bool) -> Result
         eprintln!("warning: {}: {w}", gltf.display());
     }
     let mut desc = imported.desc;
-    desc.validate()
-        .with_context(|| format!("{}: unsupported scene", gltf.display()))?;
     let scene = RenderScene::build_with(&desc, &imported.assets)
         .with_context(|| gltf.display().to_string())?;
     frame(&mut desc, &scene, cfg).with_context(|| gltf.display().to_string())?;

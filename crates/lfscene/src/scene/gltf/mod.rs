@@ -78,6 +78,9 @@ fn import_file(path: &Path, s: &ImportSettings) -> Result<Imported> {
     let assets = Assets::from_files(&desc, &file)?;
     // After loading, so the checksums of every file read are recorded.
     desc.sources = vec![file[0].source_file()?];
+    // What the renderer relies on, checked where the description is made (as SceneDesc::read
+    // does for a saved one), so no caller can skip it.
+    desc.validate().context("unsupported scene")?;
     Ok(Imported {
         desc,
         assets,
