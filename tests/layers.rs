@@ -1,5 +1,5 @@
 //! The layering of `src/` and of the crates it is built on (lfscene, lfrender, lfprocgen,
-//! lfassets), checked: each top-level module may name
+//! lfassets, lfformat), checked: each top-level module may name
 //! (`crate::…`) only the modules below it, so data flows one way — util → camera, textures →
 //! scene (description and import) → procgen / render → output, export, stats → config →
 //! pipeline, dataset, bench.
@@ -7,9 +7,10 @@
 //! Why a test: the crate graph already keeps those crates from naming anything of `lfgen` or of
 //! each other upwards, but within one crate the compiler allows any path, so a backward
 //! import would otherwise go unnoticed until it has grown into a cycle. `lfgen` re-exports
-//! lfscene's modules, lfrender (as `render`), lfprocgen (as `procgen`) and lfassets (as
-//! `catalog`) under the same names, so one table covers all. Test modules
-//! (after `#[cfg(test)]`) may use anything, as they build fixtures from the layers above.
+//! lfscene's modules, lfrender (as `render`), lfprocgen (as `procgen`) and the catalogue (as
+//! `catalog`: lfformat's schema with lfassets' converter) under the same names, so one table
+//! covers all. Test modules (after `#[cfg(test)]`) may use anything, as they build fixtures
+//! from the layers above.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs;

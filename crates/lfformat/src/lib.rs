@@ -6,6 +6,7 @@
 //! them unchanged; the multimodal files (`modes.exr`, `gt_mpi_lowres.npz`) carry every depth
 //! that contributes to a pixel, and `manifest.json` ties a dataset's scenes together.
 
+pub mod catalog;
 pub mod dataset;
 pub mod error;
 pub mod files;

@@ -10,7 +10,7 @@
 
 // The layers below under the names the generator's modules use (`crate::scene::…`); private,
 // so they are not re-exported from here.
-use lfassets as catalog;
+use lfformat::catalog;
 use lfscene::{camera, scene, textures, util};
 
 pub mod builtin;

@@ -4,7 +4,7 @@
 //! libraries: Blend Swap CC-0 and CC-BY, Kator Legaz, Reallusion, Scopia) and `sweethome3d`
 //! (the default catalogue inside `sweethome3d.jar`). [`fetch`] downloads both with
 //! `apt-get download` (no root packages are installed), unpacks them with `dpkg-deb -x`, and
-//! [`convert`] turns every usable entry into a [`catalog::Asset`](super::Asset):
+//! [`convert`] turns every usable entry into a [`catalog::Asset`](lfformat::catalog::Asset):
 //!
 //! * the libraries' `PluginFurnitureCatalog.properties` / `DefaultFurnitureCatalog.properties`
 //!   are parsed ([`parse_properties`]); entry `N` is the set of keys `field#N`;
@@ -33,10 +33,10 @@ pub use materials::{BuiltinMaterial, builtin_material};
 pub use placement::placement;
 pub use properties::{decode_properties, parse_properties};
 
-use super::{Asset, Catalog, SIZE_LIMITS, VERSION};
 use anyhow::{Context, Result, bail};
 use debian::{cached_deb, deb_version, debian_sources, run_tool};
 use indicatif::{ProgressBar, ProgressStyle};
+use lfformat::catalog::{Asset, Catalog, SIZE_LIMITS, VERSION};
 use library::{Library, parent_dir, read_entry};
 use licenses::{copyright_line, license_summary, license_url, obj_header_license};
 use materials::builtin_mtl;
@@ -712,7 +712,7 @@ fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
 mod tests {
     use super::debian::PLUGIN_CATALOG;
     use super::*;
-    use crate::AssetPlacement;
+    use lfformat::catalog::AssetPlacement;
     use std::io::Write;
 
     /// A `.sh3f` written in the test, converted field by field.
@@ -785,7 +785,7 @@ mod tests {
         assert!(summary.nonfree.is_empty());
         assert!(!dir.path().join("evil.obj").exists());
 
-        let catalog = crate::LoadedCatalog::read(&out.join("catalog.json")).unwrap();
+        let catalog = lfformat::catalog::LoadedCatalog::read(&out.join("catalog.json")).unwrap();
         let assets = &catalog.catalog.assets;
         assert_eq!(assets.len(), 2);
         let chair = &assets[0];

@@ -2,7 +2,7 @@
 //! elevation, so it is guessed from names, tags and sizes; also which entries are no
 //! furniture at all, and what others can stand on.
 
-use crate::AssetPlacement;
+use lfformat::catalog::AssetPlacement;
 use std::collections::HashMap;
 
 /// Lower-case words of a name and its tags.
