@@ -144,6 +144,7 @@ pub fn quality(cfg: &Config, scenes: &[u64], images: Option<&Path>) -> Result<()
         let mut job = RenderJob::from_config(&cfg, "");
         let converged = RenderSettings {
             spp: REFERENCE_SPP,
+            gt_spp: REFERENCE_SPP,
             ..job.settings(&desc)
         };
         let reference = scene.render_view(cam, &desc.slices, &converged, center, true, &counter);

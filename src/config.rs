@@ -163,6 +163,11 @@ pub enum ShadingMode {
 pub struct RenderConfig {
     /// Samples per pixel (stratified over the pixel, box filter).
     pub spp: u32,
+    /// Camera samples per pixel of the ground truth (modes, η, MPI colours); left out: `spp`,
+    /// and the GT comes from the colour's own rays at no extra tracing. More samples make η
+    /// at edges and behind semi-transparent surfaces finer than the colour's spp allows.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gt_spp: Option<u32>,
     /// Maximum number of path vertices after the camera.
     pub max_depth: u32,
     /// Russian roulette starts after this many bounces.
@@ -199,6 +204,7 @@ impl Default for RenderConfig {
     fn default() -> Self {
         Self {
             spp: 16,
+            gt_spp: None,
             max_depth: 5,
             rr_depth: 3,
             gt_views: GtViews::Center,
@@ -342,6 +348,11 @@ impl Config {
         let r = &self.render;
         if r.spp == 0 || r.slices == 0 || r.max_depth == 0 {
             bail!("render.spp, render.slices and render.max_depth must be at least 1");
+        }
+        if let Some(n) = r.gt_spp
+            && !(1..=MAX_SPP).contains(&n)
+        {
+            bail!("render.gt_spp must be 1 to {MAX_SPP}, got {n}");
         }
         if r.cache_spp == 0 || r.cache_spp > MAX_SPP {
             bail!(

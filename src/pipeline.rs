@@ -22,6 +22,8 @@ use std::sync::atomic::AtomicU64;
 #[derive(Clone, Debug)]
 pub struct RenderJob {
     pub spp: u32,
+    /// Camera samples per pixel of the ground truth (`spp` unless configured).
+    pub gt_spp: u32,
     pub path: PathSettings,
     pub gt_views: GtViews,
     pub mode_epsilon: f32,
@@ -46,6 +48,7 @@ impl RenderJob {
         let r = &cfg.render;
         Self {
             spp: r.spp,
+            gt_spp: r.gt_spp.unwrap_or(r.spp),
             path: PathSettings {
                 max_depth: r.max_depth,
                 rr_depth: r.rr_depth,
@@ -66,12 +69,23 @@ impl RenderJob {
         }
     }
 
-    /// Camera samples per pixel of one view, the fill pass of shared shading included.
-    pub fn samples_per_pixel(&self) -> u32 {
-        match self.shading {
-            ShadingMode::Shared => self.spp + self.cache_spp,
-            ShadingMode::Independent => self.spp,
-        }
+    /// Camera samples per pixel position over the `views` views of a scene: every view's
+    /// colour, the fill pass of shared shading, and the GT's own samples where it has them.
+    pub fn samples_per_pixel(&self, views: u32) -> u64 {
+        let fill = match self.shading {
+            ShadingMode::Shared => self.cache_spp,
+            ShadingMode::Independent => 0,
+        };
+        let gt_views = match self.gt_views {
+            GtViews::All => views,
+            GtViews::Center => 1,
+        };
+        let gt_own = if self.gt_spp == self.spp {
+            0
+        } else {
+            self.gt_spp
+        };
+        views as u64 * (self.spp + fill) as u64 + gt_views as u64 * gt_own as u64
     }
 
     /// Per-view render settings for scene `desc`.
@@ -87,6 +101,7 @@ impl RenderJob {
                 ..self.path
             },
             spp: self.spp,
+            gt_spp: self.gt_spp,
             seed: desc.seed,
             scene_index: desc.index,
             mode_epsilon: self.mode_epsilon,

@@ -388,6 +388,30 @@ fn occluder_edge_fraction() {
     }
 }
 
+/// `gt_spp` gives the ground truth its own samples: one colour sample per pixel, yet the edge
+/// column's η as precise as 64 samples make it (the same bound as above), and the colour
+/// image bit for bit the one rendered without any GT; and the other way round, 64 colour
+/// samples with one GT sample give η of 0 or 1 only.
+#[test]
+fn gt_spp_sets_the_precision_of_eta_apart_from_the_colour() {
+    let h = occluder_edge();
+    let cam = &h.desc.camera;
+    let view = cam.center_view();
+    let mut s = settings(1, 1);
+    s.gt_spp = 64;
+    let with = h.render(view, &s, true);
+    assert!(bits(&with) == bits(&h.render(view, &s, false)));
+    let mean = assert_edge_view(cam, with.gt.as_ref().unwrap(), EDGE_X, "gt_spp 64");
+    assert!((mean - 0.3).abs() < EDGE_MEAN_TOL, "column mean {mean}");
+    let (mut s, col) = (settings(64, 1), EDGE_X as usize);
+    s.gt_spp = 1;
+    let g = gt(h.render(view, &s, true));
+    for y in 0..g.modes.height {
+        let modes = g.modes.pixel(col, y);
+        assert!(modes.len() == 1 && modes[0].eta == 1.0, "y {y}: {modes:?}");
+    }
+}
+
 /// Checks every pixel against an edge at image x = `edge`; returns the edge column's mean η.
 fn assert_edge_view(cam: &LightFieldCamera, g: &ViewGt, edge: f64, what: &str) -> f32 {
     let (col, f) = (edge.floor() as usize, edge.fract());

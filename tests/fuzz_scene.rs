@@ -72,6 +72,7 @@ fn run_in_process(v: Value) -> Outcome {
             footprint: 0.0,
         },
         spp: 1,
+        gt_spp: 1,
         seed: 0,
         scene_index: 0,
         mode_epsilon: 0.01,
@@ -174,6 +175,8 @@ fn hostile_config_values_are_refused_with_the_key_named() {
     let cases = [
         "render.slices=4294967295",
         "render.spp=4294967295",
+        "render.gt_spp=0",
+        "render.gt_spp=4294967295",
         "render.max_depth=100000",
         "camera.grid=[0,0]",
         "camera.grid=[35,35]",

@@ -78,6 +78,7 @@ impl Loaded {
                 footprint: 0.0,
             },
             spp,
+            gt_spp: spp,
             seed: 3,
             scene_index: 0,
             mode_epsilon: 1e-4,

@@ -149,6 +149,7 @@ pub fn settings(spp: u32, max_depth: u32) -> RenderSettings {
             footprint: 0.0,
         },
         spp,
+        gt_spp: spp,
         seed: 11,
         scene_index: 0,
         mode_epsilon: 1e-4,

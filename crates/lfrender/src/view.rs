@@ -19,6 +19,10 @@ use std::sync::atomic::{AtomicU64, Ordering};
 pub struct RenderSettings {
     pub path: PathSettings,
     pub spp: u32,
+    /// Camera samples per pixel of the ground truth (modes, η, mode colours). Equal to `spp`,
+    /// the GT is built from the colour's own rays (one all-hits trace serves both); otherwise
+    /// from `gt_spp` rays of its own, so η is not limited by the colour's sample count.
+    pub gt_spp: u32,
     pub seed: u64,
     pub scene_index: u64,
     pub mode_epsilon: f32,
@@ -26,6 +30,16 @@ pub struct RenderSettings {
     /// colour goes to the slice of the surface it saw).
     pub shade_all_hits: bool,
     pub slice_assignment: SliceAssignment,
+}
+
+impl RenderSettings {
+    /// Camera samples per pixel of a view: the colour's, plus the GT's own where it has them.
+    pub fn samples_per_pixel(&self, with_gt: bool) -> u32 {
+        match with_gt && self.gt_spp != self.spp {
+            true => self.spp + self.gt_spp,
+            false => self.spp,
+        }
+    }
 }
 
 /// Linear radiance, row-major from the top-left.
@@ -86,6 +100,9 @@ const FILL_STREAM: u64 = 0xF111_CACE;
 /// same whatever the shading mode draws along the path: an independent render and a shared one
 /// write byte-identical `modes.exr`.
 const PATH_STREAM: u64 = 0xA7B5_7EA3;
+
+/// Salt of the ground truth's own camera and path streams when `gt_spp` differs from `spp`.
+const GT_STREAM: u64 = 0x6700_57EA;
 
 impl RenderScene {
     /// Renders `view` with the independent estimator; `samples_done` counts camera samples
@@ -204,7 +221,8 @@ impl RenderScene {
                             };
                             ctx.render(with_gt, scratch, &mut band);
                         }
-                        samples_done.fetch_add(w as u64 * settings.spp as u64, Ordering::Relaxed);
+                        let per_pixel = settings.samples_per_pixel(with_gt);
+                        samples_done.fetch_add(w as u64 * per_pixel as u64, Ordering::Relaxed);
                     }
                     band
                 },
@@ -262,13 +280,10 @@ struct PixelCtx<'a> {
 impl PixelCtx<'_> {
     fn render(&self, with_gt: bool, scratch: &mut Scratch, band: &mut Band) {
         let s = self.settings;
-        let (view, x, y) = (self.view, self.x, self.y);
-        let mut camera = Sampler::new(s.seed, s.scene_index, view, x, y, s.spp);
-        let mut sampler = Sampler::new(s.seed, s.scene_index ^ PATH_STREAM, view, x, y, 1);
-        let mut sum = Vec3::ZERO;
-        let centre = self.centre;
+        // The colour's rays carry the GT too, unless the GT has its own sample count.
+        let gt_inline = with_gt && s.gt_spp == s.spp;
         if with_gt {
-            let geo = &self.scene.geometry;
+            let (centre, geo) = (self.centre, &self.scene.geometry);
             geo.all_hits(
                 centre.origin,
                 centre.dir,
@@ -276,12 +291,41 @@ impl PixelCtx<'_> {
                 &mut scratch.centre_hits,
             );
         }
-        for i in 0..s.spp {
+        let sum = self.samples(s.scene_index, s.spp, gt_inline, scratch);
+        if with_gt && !gt_inline {
+            self.samples(s.scene_index ^ GT_STREAM, s.gt_spp, true, scratch);
+        }
+        band.pixels.push(sum / s.spp as f32);
+        if with_gt {
+            let before = band.modes.len();
+            let cam = self.cam;
+            scratch.acc.finish_pixel(
+                |z| cam.disparity(z),
+                s.mode_epsilon,
+                &mut band.modes,
+                &mut band.colors,
+            );
+            band.mode_counts.push((band.modes.len() - before) as u32);
+            band.hci_depth
+                .push(self.hci_depth(&scratch.centre_hits, self.centre.dir));
+        }
+    }
+
+    /// Traces `n` stratified camera samples of the pixel from the streams of `stream`
+    /// (camera: pixel positions and transparency keys; path: its own) and returns the sum of
+    /// their radiance; with `gt` every hit also goes into the slice accumulator.
+    fn samples(&self, stream: u64, n: u32, gt: bool, scratch: &mut Scratch) -> Vec3 {
+        let s = self.settings;
+        let (view, x, y) = (self.view, self.x, self.y);
+        let mut camera = Sampler::new(s.seed, stream, view, x, y, n);
+        let mut sampler = Sampler::new(s.seed, stream ^ PATH_STREAM, view, x, y, 1);
+        let mut sum = Vec3::ZERO;
+        for i in 0..n {
             sampler.start_sample(i);
             let off = camera.pixel_offset(i);
-            let ray = self.rays.ray(self.x as f32 + off.x, self.y as f32 + off.y);
+            let ray = self.rays.ray(x as f32 + off.x, y as f32 + off.y);
             let key = camera.next_key();
-            sum += if with_gt {
+            sum += if gt {
                 self.sample_with_gt(ray.origin, ray.dir, key, &mut sampler, scratch)
             } else {
                 let first = self.scene.geometry.closest(
@@ -302,20 +346,7 @@ impl PixelCtx<'_> {
                 traced.radiance
             };
         }
-        band.pixels.push(sum / s.spp as f32);
-        if with_gt {
-            let before = band.modes.len();
-            let cam = self.cam;
-            scratch.acc.finish_pixel(
-                |z| cam.disparity(z),
-                s.mode_epsilon,
-                &mut band.modes,
-                &mut band.colors,
-            );
-            band.mode_counts.push((band.modes.len() - before) as u32);
-            band.hci_depth
-                .push(self.hci_depth(&scratch.centre_hits, centre.dir));
-        }
+        sum
     }
 
     /// Collects every hit of a sample ray into the slice accumulator and returns the radiance
