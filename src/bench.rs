@@ -180,8 +180,15 @@ pub fn quality(cfg: &Config, scenes: &[u64], images: Option<&Path>) -> Result<()
             job.shading = shading;
             let settings = job.settings(&desc);
             let started = Instant::now();
-            let cache = (shading == ShadingMode::Shared)
-                .then(|| scene.fill_cache(cam, &settings, job.cache_spp, job.cache_cell, &counter));
+            let cache = (shading == ShadingMode::Shared).then(|| {
+                scene.fill_cache(
+                    cam,
+                    &settings,
+                    job.fill_spp(cam.num_views()),
+                    job.cache_cell,
+                    &counter,
+                )
+            });
             let fill = started.elapsed().as_secs_f64();
             let mode = cache.as_ref().map_or(Shading::Independent, Shading::Read);
             let render = |view| {
