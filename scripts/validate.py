@@ -291,6 +291,26 @@ def cmd_timed(a):
         f.write(f"{time.time() - t0} {children_cpu() - c0}\n")
 
 
+def psnr(ref, img):
+    """PSNR of linear `img` against `ref`, both scaled by the reference's automatic exposure
+    (key 0.18 on the log-average luminance, as lfgen's `auto_exposure`), peak 1: the figure
+    `lfgen bench --quality` calls linear PSNR."""
+    lum = ref @ np.array([0.2126, 0.7152, 0.0722])
+    k = 0.18 / np.exp(np.mean(np.log(lum + 1e-4)))
+    return -10 * np.log10(np.mean(((img - ref) * k) ** 2))
+
+
+def load_image(path):
+    return np.load(path) if path.endswith(".npy") else rgb(read_exr(path))
+
+
+def cmd_psnr(a):
+    """Prints the PSNR of every image against the reference, one per line."""
+    ref = load_image(a.reference)
+    for path in a.images:
+        print(f"{psnr(ref, load_image(path)):.2f} {path}")
+
+
 def cmd_mitsuba_render(a):
     import mitsuba as mi
 
@@ -432,13 +452,17 @@ def main():
     r.add_argument("--variant", default="scalar_rgb")
     r.add_argument("--spp", type=int, default=256)
     r.add_argument("--seed", type=int, default=0)
+    s = sub.add_parser("psnr")
+    s.add_argument("reference", help="linear EXR or .npy")
+    s.add_argument("images", nargs="+")
     v = sub.add_parser("povdirect")
     v.add_argument("pov", help="POV-Ray export folder (cameras.inc, geometry.inc)")
     v.add_argument("blender", help="Blender export folder of the same scene (materials, meshes)")
     v.add_argument("--light-area", type=float, default=0.01, help="largest point-light patch, m²")
     a = p.parse_args()
     {"depth": cmd_depth, "match": cmd_match, "colour": cmd_colour,
-     "mitsuba-render": cmd_mitsuba_render, "povdirect": cmd_povdirect, "timed": cmd_timed}[a.cmd](a)
+     "mitsuba-render": cmd_mitsuba_render, "povdirect": cmd_povdirect, "timed": cmd_timed,
+     "psnr": cmd_psnr}[a.cmd](a)
 
 
 if __name__ == "__main__":

@@ -193,7 +193,7 @@ pub struct RenderConfig {
     /// `shared` (default) or `independent` shading (see [`ShadingMode`]).
     pub shading: ShadingMode,
     /// Shared shading: fill samples per pixel of every view, at least; raised to
-    /// ⌈4 · spp / views⌉ so the cache's noise shrinks with spp (`RenderJob::fill_spp`).
+    /// ⌈spp / views⌉ so the cache's noise shrinks with spp (`RenderJob::fill_spp`).
     pub cache_spp: u32,
     /// Shared shading: cache cell size in pixels of the centre view at the cell's depth.
     pub cache_cell: f64,

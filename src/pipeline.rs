@@ -19,7 +19,7 @@ use std::path::Path;
 use std::sync::atomic::AtomicU64;
 
 /// Fill samples a shared-shading cache cell gathers per colour sample of a pixel, at least.
-pub const FILL_PER_SPP: u32 = 4;
+pub const FILL_PER_SPP: u32 = 1;
 
 /// Rendering choices that are not part of the scene itself.
 #[derive(Clone, Debug)]
@@ -95,9 +95,10 @@ impl RenderJob {
     /// Fill samples per pixel of each of `views` views: `cache_spp`, raised so that a cache
     /// cell (about one pixel footprint) gathers at least [`FILL_PER_SPP`] × `spp` samples over
     /// the views. The shared estimate is all a Lambert pixel's lighting, so a fixed fill
-    /// would put a floor under its noise however high `spp` goes (validate.sh, 3×3 views at
-    /// 1024 spp: 4.98 % mean block difference against Mitsuba with 4 fill samples per view,
-    /// 0.69 % with 456). At the defaults (16 spp, 81 views) the floor of 4 is already 20 × spp.
+    /// would put a floor under its noise however high `spp` goes (validate.sh, the centre
+    /// view alone at 1024 spp: 4.98 % mean block difference against Mitsuba with 4 fill
+    /// samples, 0.84 / 0.51 % with 114 / 1024, the independent estimator 0.31 %). At the
+    /// defaults (16 spp, 81 views) the floor of 4 per view is already 20 × spp per cell.
     pub fn fill_spp(&self, views: u32) -> u32 {
         let per_view = (FILL_PER_SPP * self.spp).div_ceil(views.max(1));
         self.cache_spp.max(per_view)
@@ -343,11 +344,12 @@ mod tests {
     fn the_fill_grows_with_spp_over_the_views() {
         // Defaults: 16 spp over 81 views needs 1 per view; the floor of 4 stays.
         assert_eq!(job(16, 4, None).fill_spp(81), 4);
-        // validate.sh: 1024 spp over 3×3 views → ⌈4096 / 9⌉ = 456 per view.
-        assert_eq!(job(1024, 4, None).fill_spp(9), 456);
-        // An explicit cache_spp above the rule wins; one view takes 4 × spp.
+        // 1024 spp over 3×3 views → ⌈1024 / 9⌉ = 114 per view; validate.sh's single view
+        // takes all 1024 itself.
+        assert_eq!(job(1024, 4, None).fill_spp(9), 114);
+        assert_eq!(job(1024, 4, None).fill_spp(1), 1024);
+        // An explicit cache_spp above the rule wins.
         assert_eq!(job(1024, 500, None).fill_spp(9), 500);
-        assert_eq!(job(8, 4, None).fill_spp(1), 32);
     }
 
     #[test]
