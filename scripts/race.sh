@@ -4,12 +4,13 @@
 # every material made Lambert and opaque (validate.py match --diffuse), so both renderers
 # converge to one image; the reference is Mitsuba 3 at REF_SPP on the centre view, a third
 # renderer. lfgen renders the 81 views at its default settings (shared shading, 16 spp, centre
-# GT) and at SPPS with independent shading; Cycles renders the centre view at SPPS. PSNR is
-# linear, scaled by the reference's automatic exposure, peak 1 (validate.py psnr). Cycles' time
-# for 81 views is its start-up (a 1-spp render) plus 81 times the rest, as if one process
-# rendered them all.
+# GT) and at LF_SPPS with independent shading; Cycles renders the centre view at CYCLES_SPPS.
+# PSNR is linear, scaled by the reference's automatic exposure, peak 1 (validate.py psnr).
+# Cycles' time for 81 views is its start-up (a 1-spp render) plus 81 times the rest, as if one
+# process rendered them all.
 #
-#   scripts/race.sh            # OUT=target/race RES=128,128 REF_SPP=4096 SPPS="4 16 64 256"
+#   scripts/race.sh    # OUT=target/race RES=128,128 REF_SPP=4096 LF_SPPS="16 64" VENV=…
+#                      # CYCLES_SPPS="16 64 256 1024"
 #
 # Needs what scripts/validate.sh needs (python3 with mitsuba, numpy, OpenEXR; blender).
 set -euo pipefail
@@ -17,28 +18,19 @@ cd "$(dirname "$0")/.."
 OUT=$(realpath -m "${OUT:-target/race}")
 RES=${RES:-128,128}
 REF_SPP=${REF_SPP:-4096}
-SPPS=${SPPS:-4 16 64 256}
-if [ -z "${LF:-}" ]; then
-    cargo build --release --quiet
-    LF=$(realpath target/release/lfgen)
-fi
-mkdir -p "$OUT"
-lf() { (cd "$OUT" && "$LF" "$@"); }
-if [ ! -x "$OUT/venv/bin/python" ]; then
-    python3 -m venv "$OUT/venv"
-    "$OUT/venv/bin/pip" install --quiet mitsuba numpy OpenEXR
-fi
-PY="$OUT/venv/bin/python"
-VAL="$(pwd)/scripts/validate.py"
+LF_SPPS=${LF_SPPS:-16 64}
+CYCLES_SPPS=${CYCLES_SPPS:-16 64 256 1024}
+# shellcheck source=scripts/tools.sh
+. scripts/tools.sh
 command -v blender >/dev/null || { echo "blender not found (Debian: apt-get install blender)"; exit 1; }
 
-rm -rf "$OUT/ds" "$OUT/matched" "$OUT/mitsuba" "$OUT/blender" "$OUT/lfgen"* "$OUT/cycles"
+rm -rf "$OUT/ds" "$OUT/matched" "$OUT/mitsuba" "$OUT/blender"* "$OUT/lfgen"* "$OUT/cycles"
 lf --scenes 1 --out "$OUT/ds" --set "camera.resolution=[$RES]" --set dataset.date=2026-01-01 \
     --quiet
 SCENE="$OUT/ds/train/scene_0000"
-lf export --to blender "$SCENE" --out "$OUT/blender" --views center
+lf export --to blender "$SCENE" --out "$OUT/blender_source" --views center
 mkdir -p "$OUT/matched"
-$PY "$VAL" match "$SCENE/scene.json" "$OUT/blender/blender_scene.json" "$OUT/matched/scene.json" \
+$PY "$VAL" match "$SCENE/scene.json" "$OUT/blender_source/blender_scene.json" "$OUT/matched/scene.json" \
     --dielectric-only --diffuse
 lf export --to mitsuba "$OUT/matched" --out "$OUT/mitsuba" --views center
 lf export --to blender "$OUT/matched" --out "$OUT/blender" --views center
@@ -61,7 +53,7 @@ lf_run() {  # name, then --set arguments
 }
 t=$(lf_run lfgen_default)
 row lfgen "shared (default)" 16 "$OUT/lfgen_default/input_Cam$(printf %03d "$CENTRE").exr" "$t"
-for spp in $SPPS; do
+for spp in $LF_SPPS; do
     t=$(lf_run "lfgen_$spp" --set render.spp="$spp" --set render.shading=independent)
     row lfgen independent "$spp" "$OUT/lfgen_$spp/input_Cam$(printf %03d "$CENTRE").exr" "$t"
 done
@@ -75,7 +67,7 @@ cycles() {  # spp → seconds of one centre-view render
     echo "$t1 - $t0" | bc
 }
 start=$(cycles 1)
-for spp in $SPPS; do
+for spp in $CYCLES_SPPS; do
     t=$(cycles "$spp")
     total=$(echo "$start + 81 * ($t - $start)" | bc)
     row Cycles "Diffuse BSDF" "$spp" "$OUT/cycles/spp$spp.exr" "$(printf %.1f "$total")"

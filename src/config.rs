@@ -8,6 +8,7 @@
 use crate::camera::LightFieldCamera;
 use crate::output::images::ToneCurve;
 pub use crate::procgen::settings::RoomSettings as SceneConfig;
+pub use crate::render::integrator::GlassLight;
 pub use crate::render::slices::SliceAssignment;
 pub use crate::scene::SliceSpacing;
 pub use crate::scene::gltf::GltfSettings as GltfConfig;
@@ -199,6 +200,9 @@ pub struct RenderConfig {
     pub cache_cell: f64,
     /// Average library textures seen by camera rays over one sample's footprint.
     pub texture_filter: bool,
+    /// Light through smooth glass: `caustics` (default, unbiased), `shadows` or `off` (see
+    /// [`GlassLight`]).
+    pub glass_light: GlassLight,
 }
 
 impl Default for RenderConfig {
@@ -222,6 +226,7 @@ impl Default for RenderConfig {
             cache_spp: 4,
             cache_cell: 1.0,
             texture_filter: true,
+            glass_light: GlassLight::Caustics,
         }
     }
 }

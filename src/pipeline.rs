@@ -57,6 +57,7 @@ impl RenderJob {
                 max_depth: r.max_depth,
                 rr_depth: r.rr_depth,
                 footprint: 0.0, // per scene: see `settings`
+                glass_light: r.glass_light,
             },
             gt_views: r.gt_views,
             mode_epsilon: r.mode_epsilon as f32,

@@ -70,6 +70,7 @@ fn run_in_process(v: Value) -> Outcome {
             max_depth: 3,
             rr_depth: 2,
             footprint: 0.0,
+            glass_light: lfgen::render::integrator::GlassLight::Caustics,
         },
         spp: 1,
         gt_spp: 1,

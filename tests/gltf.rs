@@ -76,6 +76,7 @@ impl Loaded {
                 max_depth: 1,
                 rr_depth: 2,
                 footprint: 0.0,
+                glass_light: lfgen::render::integrator::GlassLight::Caustics,
             },
             spp,
             gt_spp: spp,

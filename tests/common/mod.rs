@@ -147,6 +147,7 @@ pub fn settings(spp: u32, max_depth: u32) -> RenderSettings {
             max_depth,
             rr_depth: max_depth + 1,
             footprint: 0.0,
+            glass_light: lfgen::render::integrator::GlassLight::Caustics,
         },
         spp,
         gt_spp: spp,

@@ -269,16 +269,20 @@ impl Geometry {
     }
 
     /// Fraction of light passing from `origin` along `dir` to distance `tmax`: the product of
-    /// `1 - opacity` over semi-transparent surfaces; opaque surfaces and glass block.
+    /// `1 - opacity` over semi-transparent surfaces; opaque surfaces block. Smooth glass blocks
+    /// too, unless `through_glass`: then each glass interface passes its tint times
+    /// `1 − Fresnel` along the straight line (no refraction; see `GlassLight::Shadows`). Also
+    /// says whether the segment crossed glass.
     pub fn transmittance(
         &self,
         mats: &[RenderMaterial],
         origin: Vec3,
         dir: Vec3,
         tmax: f32,
-    ) -> f32 {
+        through_glass: bool,
+    ) -> (Vec3, bool) {
         let ray = Ray::new(origin.into(), dir.into(), 0.0, tmax);
-        let mut tr = 1.0f32;
+        let (mut tr, mut crossed_glass) = (Vec3::ONE, false);
         let clear = self.bvh.ray_traverse_miss(ray, |r, leaf| {
             let (t, b) = self.intersect(r, leaf);
             if t.is_finite() {
@@ -288,19 +292,30 @@ impl Geometry {
                     b,
                 };
                 let m = &mats[self.shading[leaf].material as usize];
-                let a = if m.glass_ior.is_some() {
-                    1.0
-                } else {
-                    self.opacity(mats, &hit)
+                crossed_glass |= m.glass_ior.is_some();
+                let passed = match m.glass_ior {
+                    Some(ior) if through_glass => self.glass_transmittance(m, &hit, dir, ior),
+                    Some(_) => Vec3::ZERO,
+                    None => Vec3::splat(1.0 - self.opacity(mats, &hit)),
                 };
-                if a >= 1.0 {
+                if passed == Vec3::ZERO {
                     return t;
                 }
-                tr *= 1.0 - a;
+                tr *= passed;
             }
             f32::INFINITY
         });
-        if clear { tr } else { 0.0 }
+        (if clear { tr } else { Vec3::ZERO }, crossed_glass)
+    }
+
+    /// What one glass interface passes of light crossing it along `dir`: its tint times
+    /// `1 − F`, with F the Fresnel reflectance for the side the ray enters from (total internal
+    /// reflection passes nothing).
+    fn glass_transmittance(&self, m: &RenderMaterial, hit: &Hit, dir: Vec3, ior: f32) -> Vec3 {
+        let cos = dir.normalize().dot(self.geometric_normal(hit.tri));
+        let eta = if cos < 0.0 { ior } else { 1.0 / ior };
+        let (reflected, _) = super::bsdf::fresnel_dielectric(cos.abs(), eta);
+        m.base_color.eval(self.uv(hit)) * (1.0 - reflected).max(0.0)
     }
 
     /// GT coverage of a hit: opacity, times the Fresnel reflectance for glass (the part of the

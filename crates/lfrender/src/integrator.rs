@@ -8,6 +8,28 @@ use super::cache::{COARSER, CacheGrid, RadianceCache};
 use super::geometry::Hit;
 use super::sampler::Sampler;
 use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+/// How light that passes through smooth glass reaches the surfaces behind it. Next-event
+/// estimation cannot see a light through a refracting surface, so without help that light
+/// arrives only by BSDF-sampled paths that happen to refract into a light: refractive
+/// caustics, the grain under glass tables and behind glass shelves.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum GlassLight {
+    /// Unbiased: light through glass only by refractive caustic paths (noisy there).
+    #[default]
+    Caustics,
+    /// Shadow rays pass straight through smooth glass, weighted by its tint and `1 − F` at
+    /// each interface, and light reached by refraction after a surface vertex is dropped (that
+    /// vertex's light sample took it): the "architectural glass" of production renderers. The
+    /// bias: refraction's offset and focusing are ignored (exact for a pane with parallel
+    /// faces up to its internal reflections, off for curved or thick glass).
+    Shadows,
+    /// Refractive caustics dropped and glass opaque to shadow rays, as Cycles' "refractive
+    /// caustics" switched off: what is lit only through glass goes dark.
+    Off,
+}
 
 /// Path-tracing limits, and the texture filter of camera paths.
 #[derive(Clone, Copy, Debug)]
@@ -21,6 +43,8 @@ pub struct PathSettings {
     /// integrate the pixel while the texture detail inside each stratum, which they would
     /// only alias, is averaged instead.
     pub footprint: f32,
+    /// Light through smooth glass (see [`GlassLight`]).
+    pub glass_light: GlassLight,
 }
 
 /// Offset for spawning rays off a surface, relative to the scene scale.
@@ -44,6 +68,17 @@ pub enum Shading<'a> {
     Fill(&'a CacheGrid),
     /// Diffuse light from the cache, the glossy lobe traced by this path.
     Read(&'a RadianceCache),
+}
+
+/// A surface vertex of a path, as the light samples need it.
+struct Vertex<'a> {
+    p: Vec3,
+    hit: &'a Hit,
+    frame: &'a Frame,
+    wo_l: Vec3,
+    bsdf: &'a super::bsdf::Bsdf,
+    /// Shadow rays pass through smooth glass ([`GlassLight::Shadows`]).
+    through_glass: bool,
 }
 
 /// What a traced path found.
@@ -90,6 +125,11 @@ impl RenderScene {
         let (mut pending, mut fill) = (!matches!(shading, Shading::Independent), None);
         // Camera-ray length so far while only delta vertices were passed (texture filter).
         let mut camera_length = Some(0.0f32);
+        // Whether the path left a surface vertex (one with a light sample) and has refracted
+        // through glass since: light it reaches now is a refractive caustic.
+        let (mut left_surface, mut refracted) = (false, false);
+        let drop_caustics = settings.glass_light != GlassLight::Caustics;
+        let through_glass = settings.glass_light == GlassLight::Shadows;
         // One pass more than `max_depth` vertices: the last vertex's BSDF-sampled ray only
         // picks up the light it hits, the MIS partner of that vertex's light sample (as pbrt
         // and Mitsuba do). A light sample taking all the direct light alone instead would be
@@ -100,7 +140,9 @@ impl RenderScene {
                 radiance += beta * self.environment;
                 break;
             };
-            radiance += beta * self.emitted(&h, dir, arrival);
+            if !(drop_caustics && refracted) {
+                radiance += beta * self.emitted(&h, dir, arrival);
+            }
             if depth == settings.max_depth {
                 break;
             }
@@ -144,12 +186,20 @@ impl RenderScene {
                     }
                 }
             }
+            let vertex = Vertex {
+                p,
+                hit: &h,
+                frame: &frame,
+                wo_l,
+                bsdf: &bsdf,
+                through_glass,
+            };
             if !bsdf.is_delta() && !self.lights.is_empty() {
                 let strategy = (lobes, select);
-                radiance += beta * self.direct_light(p, &h, &frame, wo_l, &bsdf, strategy, sampler);
+                radiance += beta * self.direct_light(&vertex, strategy, sampler);
             }
             if !bsdf.is_delta() && !self.punctual_lights.is_empty() {
-                radiance += beta * self.punctual_light(p, &h, &frame, wo_l, &bsdf, lobes);
+                radiance += beta * self.punctual_light(&vertex, lobes);
             }
             if select < 1.0 {
                 if sampler.next_f32() >= select {
@@ -167,6 +217,11 @@ impl RenderScene {
             beta *= bs.f * bs.wi.z.abs() / bs.pdf;
             if !bs.is_delta {
                 camera_length = None;
+            }
+            if bsdf.is_delta() {
+                refracted |= left_surface && bs.wi.z * wo_l.z < 0.0;
+            } else {
+                (left_surface, refracted) = (true, false);
             }
             // A glossy continuation from a cached vertex reads the cache again at its next
             // non-delta vertex, as a camera path through glass does: only the lobe is per view.
@@ -224,17 +279,13 @@ impl RenderScene {
 
     /// One light sample with a shadow ray through semi-transparent surfaces, MIS-weighted
     /// against BSDF sampling of `lobes`, which the path takes with probability `select`.
-    #[allow(clippy::too_many_arguments)] // the vertex's parts, as the path loop holds them
     fn direct_light(
         &self,
-        p: Vec3,
-        h: &Hit,
-        frame: &Frame,
-        wo_l: Vec3,
-        bsdf: &super::bsdf::Bsdf,
+        v: &Vertex,
         (lobes, select): (Lobes, f32),
         sampler: &mut Sampler,
     ) -> Vec3 {
+        let (p, frame, wo_l, bsdf) = (v.p, v.frame, v.wo_l, v.bsdf);
         let ls = self.lights.sample(
             &self.geometry,
             &self.materials,
@@ -258,25 +309,23 @@ impl RenderScene {
         // Aim just off the light, on the side facing `p`: a ray that reached the light's
         // surface could count the light itself as the occluder.
         let target = ls.p + ls.n * ray_eps(ls.p);
-        let tr = self.visibility(p, h.tri, target);
-        if tr <= 0.0 {
+        let (tr, crossed_glass) = self.visibility(p, v.hit.tri, target, v.through_glass);
+        if tr == Vec3::ZERO {
             return Vec3::ZERO;
         }
         let light_pdf = ls.pdf_area * dist * dist / cos_light;
-        f * ls.emission * (tr * wi_l.z.abs() * power_heuristic(light_pdf, bsdf_pdf) / light_pdf)
+        // Through glass the BSDF partner refracts and is dropped: the light sample is alone.
+        let weight = match crossed_glass {
+            true => 1.0,
+            false => power_heuristic(light_pdf, bsdf_pdf),
+        };
+        f * ls.emission * (tr * wi_l.z.abs() * weight / light_pdf)
     }
 
     /// Light from every punctual light, each with a shadow ray through semi-transparent
     /// surfaces. A delta light has no MIS partner: no BSDF sample can hit it.
-    fn punctual_light(
-        &self,
-        p: Vec3,
-        h: &Hit,
-        frame: &Frame,
-        wo_l: Vec3,
-        bsdf: &super::bsdf::Bsdf,
-        lobes: Lobes,
-    ) -> Vec3 {
+    fn punctual_light(&self, v: &Vertex, lobes: Lobes) -> Vec3 {
+        let (p, frame, wo_l, bsdf, tri) = (v.p, v.frame, v.wo_l, v.bsdf, v.hit.tri);
         let mut sum = Vec3::ZERO;
         for light in &self.punctual_lights {
             let Some(inc) = light.incident(p) else {
@@ -287,11 +336,13 @@ impl RenderScene {
             if f == Vec3::ZERO {
                 continue;
             }
-            let tr = match inc.dist.is_finite() {
-                true => self.visibility(p, h.tri, p + inc.wi * inc.dist),
+            let glass = v.through_glass;
+            let (tr, _) = match inc.dist.is_finite() {
+                true => self.visibility(p, tri, p + inc.wi * inc.dist, glass),
                 false => {
-                    let origin = self.spawn(p, h.tri, inc.wi);
-                    (self.geometry).transmittance(&self.materials, origin, inc.wi, f32::INFINITY)
+                    let origin = self.spawn(p, tri, inc.wi);
+                    let geo = &self.geometry;
+                    geo.transmittance(&self.materials, origin, inc.wi, f32::INFINITY, glass)
                 }
             };
             sum += f * inc.irradiance * (tr * wi_l.z.abs());
@@ -323,12 +374,13 @@ impl RenderScene {
     /// from `p` it would end beside `target`, by as much as the offset over the cosine, which
     /// within ~10³ offsets of a light reaches into the light's own surface. It stops 1e-4
     /// short, so a point light placed on a surface is not hidden by it.
-    fn visibility(&self, p: Vec3, tri: u32, target: Vec3) -> f32 {
+    fn visibility(&self, p: Vec3, tri: u32, target: Vec3, through_glass: bool) -> (Vec3, bool) {
         let origin = self.spawn(p, tri, target - p);
         let to_target = target - origin;
         let dist = to_target.length();
         let tmax = dist * (1.0 - 1e-4);
-        (self.geometry).transmittance(&self.materials, origin, to_target / dist, tmax)
+        let dir = to_target / dist;
+        (self.geometry).transmittance(&self.materials, origin, dir, tmax, through_glass)
     }
 }
 
