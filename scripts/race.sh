@@ -31,7 +31,7 @@ SCENE="$OUT/ds/train/scene_0000"
 lf export --to blender "$SCENE" --out "$OUT/blender_source" --views center
 mkdir -p "$OUT/matched"
 $PY "$VAL" match "$SCENE/scene.json" "$OUT/blender_source/blender_scene.json" "$OUT/matched/scene.json" \
-    --dielectric-only --diffuse
+    --dielectric-only --diffuse --keep-grid
 lf export --to mitsuba "$OUT/matched" --out "$OUT/mitsuba" --views center
 lf export --to blender "$OUT/matched" --out "$OUT/blender" --views center
 CENTRE=$($PY -c "import json; print(json.load(open('$OUT/blender/blender_scene.json'))['cameras'][0]['view'])")
@@ -49,7 +49,7 @@ lf_run() {  # name, then --set arguments
     shift
     $PY "$VAL" timed "$OUT/$name.seconds" "$LF" render "$OUT/matched/scene.json" \
         --out "$OUT/$name" --set render.write_exr=true --quiet "$@" >/dev/null
-    cut -d' ' -f1 "$OUT/$name.seconds"
+    printf %.1f "$(cut -d' ' -f1 "$OUT/$name.seconds")"
 }
 t=$(lf_run lfgen_default)
 row lfgen "shared (default)" 16 "$OUT/lfgen_default/input_Cam$(printf %03d "$CENTRE").exr" "$t"

@@ -197,7 +197,8 @@ def cmd_match(a):
         if a.metallic is not None and m["model"]["type"] == "standard" and not any(m["emission"]):
             m["metallic"] = a.metallic
     # One view (the centre camera): timings compare one image with one image.
-    desc["camera"]["grid"] = [1, 1]
+    if not a.keep_grid:
+        desc["camera"]["grid"] = [1, 1]
     json.dump(desc, open(a.out_json, "w"))
 
 
@@ -428,6 +429,7 @@ def main():
     m.add_argument("--keep-opacity", action="store_true", help="keep mean opacities (else opaque)")
     m.add_argument("--dielectric-only", action="store_true", help="metallic 0, glass made standard")
     m.add_argument("--diffuse", action="store_true", help="every material pure Lambert")
+    m.add_argument("--keep-grid", action="store_true", help="keep every view (else the centre one)")
     m.add_argument("--roughness", type=float, help="one roughness for every Standard material")
     m.add_argument("--metallic", type=float, help="one metallic for every Standard material")
     c = sub.add_parser("colour")
