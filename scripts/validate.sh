@@ -22,18 +22,8 @@ RES=${RES:-160,120}
 SPP=${SPP:-1024}
 METAL_SPP=${METAL_SPP:-8192}
 VARIANTS=${VARIANTS:-1}
-if [ -z "${LF:-}" ]; then
-    cargo build --release --quiet
-    LF=$(realpath target/release/lfgen)
-fi
-mkdir -p "$OUT"
-lf() { (cd "$OUT" && "$LF" "$@"); }
-if [ ! -x "$OUT/venv/bin/python" ]; then
-    python3 -m venv "$OUT/venv"
-    "$OUT/venv/bin/pip" install --quiet mitsuba numpy OpenEXR
-fi
-PY="$OUT/venv/bin/python"
-VAL="$(pwd)/scripts/validate.py"
+# shellcheck source=scripts/tools.sh
+. scripts/tools.sh
 # Dr.Jit's LLVM backend (Mitsuba's llvm_ad_rgb) looks for libLLVM.so; Debian names it by version.
 if [ -z "${DRJIT_LIBLLVM_PATH:-}" ]; then
     for f in /usr/lib/x86_64-linux-gnu/libLLVM-19.so /usr/lib/llvm-19/lib/libLLVM.so; do
