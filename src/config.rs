@@ -164,11 +164,10 @@ pub enum ShadingMode {
 pub struct RenderConfig {
     /// Samples per pixel (stratified over the pixel, box filter).
     pub spp: u32,
-    /// Camera samples per pixel of the ground truth (modes, η, MPI colours); left out: `spp`,
-    /// and the GT comes from the colour's own rays at no extra tracing. More samples make η
-    /// at edges and behind semi-transparent surfaces finer than the colour's spp allows.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub gt_spp: Option<u32>,
+    /// Camera samples per pixel of the ground truth (modes, η, MPI colours); 0 (default): the
+    /// colour's own samples, at no extra tracing. More samples make η at edges and behind
+    /// semi-transparent surfaces finer than the colour's spp allows.
+    pub gt_spp: u32,
     /// Maximum number of path vertices after the camera.
     pub max_depth: u32,
     /// Russian roulette starts after this many bounces.
@@ -209,7 +208,7 @@ impl Default for RenderConfig {
     fn default() -> Self {
         Self {
             spp: 16,
-            gt_spp: None,
+            gt_spp: 0,
             max_depth: 5,
             rr_depth: 3,
             gt_views: GtViews::Center,
@@ -355,10 +354,11 @@ impl Config {
         if r.spp == 0 || r.slices == 0 || r.max_depth == 0 {
             bail!("render.spp, render.slices and render.max_depth must be at least 1");
         }
-        if let Some(n) = r.gt_spp
-            && !(1..=MAX_SPP).contains(&n)
-        {
-            bail!("render.gt_spp must be 1 to {MAX_SPP}, got {n}");
+        if r.gt_spp > MAX_SPP {
+            bail!(
+                "render.gt_spp must be 0 (spp) to {MAX_SPP}, got {}",
+                r.gt_spp
+            );
         }
         if r.cache_spp == 0 || r.cache_spp > MAX_SPP {
             bail!(

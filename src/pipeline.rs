@@ -52,7 +52,7 @@ impl RenderJob {
         let r = &cfg.render;
         Self {
             spp: r.spp,
-            gt_spp: r.gt_spp.unwrap_or(r.spp),
+            gt_spp: if r.gt_spp == 0 { r.spp } else { r.gt_spp },
             path: PathSettings {
                 max_depth: r.max_depth,
                 rr_depth: r.rr_depth,
@@ -335,7 +335,7 @@ fn publish(
 mod tests {
     use super::*;
 
-    fn job(spp: u32, cache_spp: u32, gt_spp: Option<u32>) -> RenderJob {
+    fn job(spp: u32, cache_spp: u32, gt_spp: u32) -> RenderJob {
         let mut cfg = Config::default();
         (cfg.render.spp, cfg.render.cache_spp, cfg.render.gt_spp) = (spp, cache_spp, gt_spp);
         RenderJob::from_config(&cfg, "2026-01-01")
@@ -344,20 +344,20 @@ mod tests {
     #[test]
     fn the_fill_grows_with_spp_over_the_views() {
         // Defaults: 16 spp over 81 views needs 1 per view; the floor of 4 stays.
-        assert_eq!(job(16, 4, None).fill_spp(81), 4);
+        assert_eq!(job(16, 4, 0).fill_spp(81), 4);
         // 1024 spp over 3×3 views → ⌈1024 / 9⌉ = 114 per view; validate.sh's single view
         // takes all 1024 itself.
-        assert_eq!(job(1024, 4, None).fill_spp(9), 114);
-        assert_eq!(job(1024, 4, None).fill_spp(1), 1024);
+        assert_eq!(job(1024, 4, 0).fill_spp(9), 114);
+        assert_eq!(job(1024, 4, 0).fill_spp(1), 1024);
         // An explicit cache_spp above the rule wins.
-        assert_eq!(job(1024, 500, None).fill_spp(9), 500);
+        assert_eq!(job(1024, 500, 0).fill_spp(9), 500);
     }
 
     #[test]
     fn samples_per_pixel_count_the_fill_and_the_gts_own_samples() {
         // 81 views × (16 + 4 fill); the centre GT adds 64 of its own.
-        assert_eq!(job(16, 4, None).samples_per_pixel(81), 81 * 20);
-        assert_eq!(job(16, 4, Some(64)).samples_per_pixel(81), 81 * 20 + 64);
-        assert_eq!(job(16, 4, Some(16)).samples_per_pixel(81), 81 * 20);
+        assert_eq!(job(16, 4, 0).samples_per_pixel(81), 81 * 20);
+        assert_eq!(job(16, 4, 64).samples_per_pixel(81), 81 * 20 + 64);
+        assert_eq!(job(16, 4, 16).samples_per_pixel(81), 81 * 20);
     }
 }

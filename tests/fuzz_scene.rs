@@ -176,7 +176,6 @@ fn hostile_config_values_are_refused_with_the_key_named() {
     let cases = [
         "render.slices=4294967295",
         "render.spp=4294967295",
-        "render.gt_spp=0",
         "render.gt_spp=4294967295",
         "render.max_depth=100000",
         "camera.grid=[0,0]",

@@ -291,9 +291,12 @@ impl PixelCtx<'_> {
                 &mut scratch.centre_hits,
             );
         }
-        let sum = self.samples(s.scene_index, s.spp, gt_inline, scratch);
+        // A GT view takes its colour's first hits from the all-hits trace either way, so its
+        // image does not depend on `gt_spp` (the closest-hit query can pick the other one of
+        // two coincident faces).
+        let sum = self.samples(s.scene_index, s.spp, with_gt, gt_inline, scratch);
         if with_gt && !gt_inline {
-            self.samples(s.scene_index ^ GT_STREAM, s.gt_spp, true, scratch);
+            self.samples(s.scene_index ^ GT_STREAM, s.gt_spp, true, true, scratch);
         }
         band.pixels.push(sum / s.spp as f32);
         if with_gt {
@@ -313,8 +316,16 @@ impl PixelCtx<'_> {
 
     /// Traces `n` stratified camera samples of the pixel from the streams of `stream`
     /// (camera: pixel positions and transparency keys; path: its own) and returns the sum of
-    /// their radiance; with `gt` every hit also goes into the slice accumulator.
-    fn samples(&self, stream: u64, n: u32, gt: bool, scratch: &mut Scratch) -> Vec3 {
+    /// their radiance. With `all_hits` each sample ray collects every surface and the path
+    /// starts from the first it keeps; with `gt` those hits also go into the slice accumulator.
+    fn samples(
+        &self,
+        stream: u64,
+        n: u32,
+        all_hits: bool,
+        gt: bool,
+        scratch: &mut Scratch,
+    ) -> Vec3 {
         let s = self.settings;
         let (view, x, y) = (self.view, self.x, self.y);
         let mut camera = Sampler::new(s.seed, stream, view, x, y, n);
@@ -325,8 +336,8 @@ impl PixelCtx<'_> {
             let off = camera.pixel_offset(i);
             let ray = self.rays.ray(x as f32 + off.x, y as f32 + off.y);
             let key = camera.next_key();
-            sum += if gt {
-                self.sample_with_gt(ray.origin, ray.dir, key, &mut sampler, scratch)
+            sum += if all_hits {
+                self.sample_all_hits(ray.origin, ray.dir, key, &mut sampler, scratch, gt)
             } else {
                 let first = self.scene.geometry.closest(
                     &self.scene.materials,
@@ -349,16 +360,17 @@ impl PixelCtx<'_> {
         sum
     }
 
-    /// Collects every hit of a sample ray into the slice accumulator and returns the radiance
-    /// of the surface the colour path continues from (the first kept by stochastic
-    /// transparency), exactly as the colour-only path would.
-    fn sample_with_gt(
+    /// Traces every hit of a sample ray and returns the radiance of the surface the colour
+    /// path continues from (the first kept by stochastic transparency); with `gt` the hits
+    /// also go into the slice accumulator.
+    fn sample_all_hits(
         &self,
         origin: Vec3,
         dir: Vec3,
         key: RayKey,
         sampler: &mut Sampler,
         scratch: &mut Scratch,
+        gt: bool,
     ) -> Vec3 {
         let centre = self.centre;
         let (scene, geo, mats) = (self.scene, &self.scene.geometry, &self.scene.materials);
@@ -368,6 +380,9 @@ impl PixelCtx<'_> {
         let path = &self.settings.path;
         let first_hit = first.map(|i| scratch.hits[i]);
         let radiance = (scene.trace(path, origin, dir, first_hit, sampler, self.shading)).radiance;
+        if !gt {
+            return radiance;
+        }
         scratch.slice_hits.clear();
         for (i, h) in scratch.hits.iter().enumerate() {
             let shaded = match self.settings.shade_all_hits {
