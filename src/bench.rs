@@ -185,12 +185,12 @@ pub fn quality(cfg: &Config, scenes: &[u64], images: Option<&Path>) -> Result<()
                     cam,
                     &settings,
                     job.fill_spp(cam.num_views()),
-                    job.cache_cell,
+                    job.cache,
                     &counter,
                 )
             });
             let fill = started.elapsed().as_secs_f64();
-            let mode = cache.as_ref().map_or(Shading::Independent, Shading::Read);
+            let mode = cache.as_ref().map_or(Shading::Independent, Shading::read);
             let render = |view| {
                 let t = Instant::now();
                 let out = scene.render_view_with(

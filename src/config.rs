@@ -197,6 +197,9 @@ pub struct RenderConfig {
     pub cache_spp: u32,
     /// Shared shading: cache cell size in pixels of the centre view at the cell's depth.
     pub cache_cell: f64,
+    /// Shared shading: glossy lobes at least this many times as wide as the camera grid's
+    /// angle at a point are shared by all views (see `render::cache`).
+    pub glossy_share: f64,
     /// Average library textures seen by camera rays over one sample's footprint.
     pub texture_filter: bool,
     /// Light through smooth glass: `caustics` (default, unbiased), `shadows` or `off` (see
@@ -224,6 +227,7 @@ impl Default for RenderConfig {
             shading: ShadingMode::Shared,
             cache_spp: 4,
             cache_cell: 1.0,
+            glossy_share: 4.0,
             texture_filter: true,
             glass_light: GlassLight::Caustics,
         }
@@ -370,6 +374,12 @@ impl Config {
             bail!(
                 "render.cache_cell must be 0.05 to 64 pixels, got {}",
                 r.cache_cell
+            );
+        }
+        if !(r.glossy_share.is_finite() && r.glossy_share >= 0.0) {
+            bail!(
+                "render.glossy_share must be a number ≥ 0, got {}",
+                r.glossy_share
             );
         }
         if r.spp > MAX_SPP || r.slices > MAX_SLICES || r.max_depth > MAX_DEPTH {

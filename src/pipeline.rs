@@ -7,6 +7,7 @@ use crate::output::scene_dir::{GtImages, SceneWriter};
 use crate::procgen::builtin;
 use crate::procgen::library::AssetLibrary;
 use crate::render::RenderScene;
+use crate::render::cache::CacheParams;
 use crate::render::framing::auto_exposure;
 use crate::render::integrator::{PathSettings, Shading};
 use crate::render::view::{RenderSettings, ViewOutput};
@@ -42,7 +43,7 @@ pub struct RenderJob {
     pub shading: ShadingMode,
     /// Fill samples per pixel of every view, at least (see [`RenderJob::fill_spp`]).
     pub cache_spp: u32,
-    pub cache_cell: f32,
+    pub cache: CacheParams,
     /// Filter library textures over a sample's footprint (see [`PathSettings::footprint`]).
     pub texture_filter: bool,
 }
@@ -69,7 +70,10 @@ impl RenderJob {
             date: date.to_string(),
             shading: r.shading,
             cache_spp: r.cache_spp,
-            cache_cell: r.cache_cell as f32,
+            cache: CacheParams {
+                cell_px: r.cache_cell as f32,
+                glossy_share: r.glossy_share as f32,
+            },
             texture_filter: r.texture_filter,
         }
     }
@@ -176,11 +180,11 @@ pub fn render_scene(
             &desc.camera,
             &settings,
             job.fill_spp(desc.camera.num_views()),
-            job.cache_cell,
+            job.cache,
             samples_done,
         )
     });
-    let shading = cache.as_ref().map_or(Shading::Independent, Shading::Read);
+    let shading = cache.as_ref().map_or(Shading::Independent, Shading::read);
     for view in order {
         let with_gt = view == center || per_view;
         let out = scene.render_view_with(

@@ -178,6 +178,8 @@ fn hostile_config_values_are_refused_with_the_key_named() {
         "render.spp=4294967295",
         "render.gt_spp=4294967295",
         "render.max_depth=100000",
+        "render.glossy_share=-1",
+        "render.glossy_share=nan",
         "camera.grid=[0,0]",
         "camera.grid=[35,35]",
         "camera.resolution=[4294967295,1]",

@@ -8,7 +8,7 @@ use glam::{DVec3, Vec3};
 use lfgen::camera::LightFieldCamera;
 use lfgen::config::SliceSpacing;
 use lfgen::render::RenderScene;
-use lfgen::render::cache::RadianceCache;
+use lfgen::render::cache::{CacheParams, RadianceCache};
 use lfgen::render::integrator::{PathSettings, Shading};
 use lfgen::render::slices::SliceAssignment;
 use lfgen::render::view::{RenderSettings, ViewOutput};
@@ -39,6 +39,12 @@ pub fn camera(
         up: DVec3::Y,
     }
 }
+
+/// The default cache parameters (`render.cache_cell`, `render.glossy_share`).
+pub const CACHE: CacheParams = CacheParams {
+    cell_px: 1.0,
+    glossy_share: 4.0,
+};
 
 /// Focal length in pixels, from docs/conventions.md, Camera (not from the code under test).
 pub fn f_px(cam: &LightFieldCamera) -> f64 {
@@ -177,12 +183,12 @@ impl Harness {
             .render_view(cam, slices, settings, view, with_gt, &AtomicU64::new(0))
     }
 
-    /// The shared-shading cache from `spp` fill samples per pixel of every view, cells of
-    /// one pixel.
+    /// The shared-shading cache from `spp` fill samples per pixel of every view, with the
+    /// default cells and sharing ([`CACHE`]).
     pub fn cache(&self, settings: &RenderSettings, spp: u32) -> RadianceCache {
         let cam = &self.desc.camera;
         self.scene
-            .fill_cache(cam, settings, spp, 1.0, &AtomicU64::new(0))
+            .fill_cache(cam, settings, spp, CACHE, &AtomicU64::new(0))
     }
 
     /// A view with shared shading from `cache`.
@@ -194,7 +200,7 @@ impl Harness {
         with_gt: bool,
     ) -> ViewOutput {
         let (cam, slices) = (&self.desc.camera, &self.desc.slices);
-        let shading = Shading::Read(cache);
+        let shading = Shading::read(cache);
         let done = AtomicU64::new(0);
         (self.scene).render_view_with(cam, slices, settings, view, with_gt, shading, &done)
     }

@@ -187,6 +187,25 @@ impl Bsdf {
         }
     }
 
+    /// The glossy lobe's directional albedo `A(μo) = F0·P(μo) + F90·Q(μo)`: the light it
+    /// reflects towards `wo` is this times the lobe-weighted mean of the incident light
+    /// (`render::cache` shares that mean where the lobe is wide); 0 for delta materials.
+    pub fn specular_albedo(&self, wo: Vec3) -> Vec3 {
+        match self.standard() {
+            Some(lobe) if wo.z > 0.0 => {
+                let pq = lobe.albedo_split(wo.z);
+                lobe.f0 * pq.x + lobe.f90 * pq.y
+            }
+            _ => Vec3::ZERO,
+        }
+    }
+
+    /// The glossy lobe's width, `2α` radians (about its full width at half maximum); 0 for
+    /// delta materials.
+    pub fn glossy_width(&self) -> f32 {
+        self.standard().map_or(0.0, |lobe| 2.0 * lobe.alpha)
+    }
+
     /// The share of the glossy lobe in the light leaving towards `wo` (the probability with
     /// which [`Self::sample`] picks it); 0 for delta materials.
     pub fn specular_probability(&self, wo: Vec3) -> f32 {

@@ -4,10 +4,10 @@
 
 use super::RenderScene;
 use super::bsdf::{Frame, Lobes, power_heuristic};
-use super::cache::{COARSER, CacheGrid, RadianceCache};
+use super::cache::{COARSER, CacheGrid, Estimate, RadianceCache};
 use super::geometry::Hit;
 use super::sampler::Sampler;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 
 /// How light that passes through smooth glass reaches the surfaces behind it. Next-event
@@ -66,8 +66,30 @@ pub enum Shading<'a> {
     Independent,
     /// Estimate the coupled irradiance there and end: one sample for the shared cache.
     Fill(&'a CacheGrid),
-    /// Diffuse light from the cache, the glossy lobe traced by this path.
-    Read(&'a RadianceCache),
+    /// Diffuse light from the cache; the glossy lobe too where the cache shares it, else
+    /// traced by this path. `view`: the view's position in the grid ([`Shading::seen_from`]).
+    Read {
+        cache: &'a RadianceCache,
+        view: Vec2,
+    },
+}
+
+impl<'a> Shading<'a> {
+    /// Reading `cache` (the view is set by the view's render).
+    pub fn read(cache: &'a RadianceCache) -> Self {
+        Self::Read {
+            cache,
+            view: Vec2::ZERO,
+        }
+    }
+
+    /// This shading for the view at grid position `view` (view steps from the centre).
+    pub fn seen_from(self, view: Vec2) -> Self {
+        match self {
+            Self::Read { cache, .. } => Self::Read { cache, view },
+            other => other,
+        }
+    }
 }
 
 /// A surface vertex of a path, as the light samples need it.
@@ -85,8 +107,8 @@ struct Vertex<'a> {
 pub struct Traced {
     pub radiance: Vec3,
     /// With [`Shading::Fill`]: the cells (one per level) of the first non-delta vertex and the
-    /// coupled irradiance estimated there (none if the path never reached one).
-    pub fill: Option<([u64; COARSER + 1], Vec3)>,
+    /// estimate made there (none if the path never reached one).
+    pub fill: Option<([u64; COARSER + 1], Estimate)>,
 }
 
 impl RenderScene {
@@ -168,19 +190,38 @@ impl RenderScene {
                 match shading {
                     Shading::Independent => {}
                     Shading::Fill(grid) => {
-                        // From here the path estimates I(p): light before it is not part of it.
-                        fill = Some(grid.keys(p, frame.n, s.material));
-                        (radiance, beta, lobes) = (Vec3::ZERO, Vec3::ONE, Lobes::CoupledIrradiance);
+                        // From here the path estimates I(p), or the shared glossy term: light
+                        // before it is not part of it.
+                        let glossy = self.fills_glossy(grid, p, &bsdf, wo_l, sampler);
+                        let cells = grid.keys(p, frame.n, s.material);
+                        fill = Some((cells, glossy));
+                        (radiance, beta, lobes) = match glossy {
+                            true => {
+                                let albedo = bsdf.specular_albedo(wo_l);
+                                (
+                                    Vec3::ZERO,
+                                    albedo.max(Vec3::splat(1e-6)).recip(),
+                                    Lobes::Specular,
+                                )
+                            }
+                            false => (Vec3::ZERO, Vec3::ONE, Lobes::CoupledIrradiance),
+                        };
                     }
-                    Shading::Read(cache) => {
-                        if let Some(i) = cache.lookup(p, frame.n, s.material) {
-                            radiance += beta * bsdf.diffuse_out(wo_l) * i;
-                            // The glossy lobe per view: its light sample always, its
-                            // continuation as often as the lobe matters.
+                    Shading::Read { cache, view } => {
+                        if let Some(c) = cache.lookup(p, frame.n, s.material) {
+                            radiance += beta * bsdf.diffuse_out(wo_l) * c.irradiance;
                             let q = bsdf.specular_probability(wo_l);
                             if q <= 0.0 {
                                 break;
                             }
+                            let width = bsdf.glossy_width();
+                            let shared = c.glossy.filter(|_| cache.grid.shares_glossy(p, width));
+                            if let Some(g) = shared {
+                                radiance += beta * bsdf.specular_albedo(wo_l) * g.at(view);
+                                break;
+                            }
+                            // The glossy lobe per view: its light sample always, its
+                            // continuation as often as the lobe matters.
                             (select, lobes) = (q, Lobes::Specular);
                         }
                     }
@@ -225,7 +266,7 @@ impl RenderScene {
             }
             // A glossy continuation from a cached vertex reads the cache again at its next
             // non-delta vertex, as a camera path through glass does: only the lobe is per view.
-            pending |= matches!(lobes, Lobes::Specular);
+            pending |= lobes == Lobes::Specular && matches!(shading, Shading::Read { .. });
             arrival = Arrival {
                 pdf: bs.pdf * select,
                 is_delta: bs.is_delta,
@@ -248,10 +289,33 @@ impl RenderScene {
                 sampler.next_key(),
             );
         }
+        let estimate = |glossy| match glossy {
+            true => Estimate::Glossy(radiance),
+            false => Estimate::Irradiance(radiance),
+        };
         Traced {
             radiance,
-            fill: fill.map(|key| (key, radiance)),
+            fill: fill.map(|(cells, glossy)| (cells, estimate(glossy))),
         }
+    }
+
+    /// Whether a fill sample estimates the shared glossy term at its first vertex (else the
+    /// coupled irradiance). Only where the lobe is shared; then with the lobe's share of the
+    /// reflected light, kept within [1/8, 1/2] so neither estimate starves (each cell averages
+    /// the samples that made it, so the choice biases neither).
+    fn fills_glossy(
+        &self,
+        grid: &CacheGrid,
+        p: Vec3,
+        bsdf: &super::bsdf::Bsdf,
+        wo_l: Vec3,
+        sampler: &mut Sampler,
+    ) -> bool {
+        let q = bsdf.specular_probability(wo_l);
+        if q <= 0.0 || !grid.shares_glossy(p, bsdf.glossy_width()) {
+            return false;
+        }
+        sampler.next_f32() < q.clamp(0.125, 0.5)
     }
 
     /// Emission picked up at a hit, MIS-weighted against light sampling unless the path

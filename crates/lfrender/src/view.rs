@@ -2,14 +2,14 @@
 //! for the views that need it.
 
 use super::RenderScene;
-use super::cache::{CacheGrid, CacheSums, RadianceCache};
+use super::cache::{CacheGrid, CacheParams, CacheSums, RadianceCache};
 use super::geometry::Hit;
 use super::integrator::{PathSettings, Shading};
 use super::sampler::{RayKey, Sampler};
 use super::slices::{SliceAccumulator, SliceAssignment, SliceHit};
 use crate::camera::{CameraRay, LightFieldCamera, ViewRays};
 use crate::scene::SliceRange;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use lfformat::{Mode, ModeMap};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -127,21 +127,23 @@ impl RenderScene {
         cam: &LightFieldCamera,
         settings: &RenderSettings,
         spp: u32,
-        cell_px: f32,
+        params: CacheParams,
         samples_done: &AtomicU64,
     ) -> RadianceCache {
-        let grid = CacheGrid::new(cam, cell_px);
+        let grid = CacheGrid::new(cam, params);
         let (w, h) = (cam.width(), cam.height());
         let mut all = CacheSums::default();
         for view in 0..cam.num_views() {
             let rays = cam.view_rays(view);
+            let uv = grid_position(cam, view);
             let bands: Vec<CacheSums> = (0..h.div_ceil(BAND_ROWS))
                 .into_par_iter()
                 .map(|b| {
                     let mut sums = CacheSums::default();
                     for y in b * BAND_ROWS..((b + 1) * BAND_ROWS).min(h) {
                         for x in 0..w {
-                            self.fill_pixel(&rays, settings, &grid, (view, x, y), spp, &mut sums);
+                            let pixel = (view, x, y);
+                            self.fill_pixel(&rays, settings, &grid, pixel, spp, &mut sums, uv);
                         }
                         samples_done.fetch_add(w as u64 * spp as u64, Ordering::Relaxed);
                     }
@@ -153,7 +155,8 @@ impl RenderScene {
         all.finish(grid)
     }
 
-    /// The fill samples of one pixel.
+    /// The fill samples of one pixel of the view at grid position `uv`.
+    #[allow(clippy::too_many_arguments)]
     fn fill_pixel(
         &self,
         rays: &ViewRays,
@@ -162,6 +165,7 @@ impl RenderScene {
         (view, x, y): (u32, u32, u32),
         spp: u32,
         sums: &mut CacheSums,
+        uv: Vec2,
     ) {
         let scene = s.scene_index ^ FILL_STREAM;
         let mut sampler = Sampler::new(s.seed, scene, view, x, y, spp);
@@ -173,8 +177,8 @@ impl RenderScene {
                 (self.geometry).closest(&self.materials, ray.origin, ray.dir, f32::INFINITY, key);
             let fill = Shading::Fill(grid);
             let traced = self.trace(&s.path, ray.origin, ray.dir, first, &mut sampler, fill);
-            if let Some((cells, value)) = traced.fill {
-                sums.add(&cells, value);
+            if let Some((cells, estimate)) = traced.fill {
+                sums.add(&cells, estimate, uv);
             }
         }
     }
@@ -193,6 +197,7 @@ impl RenderScene {
     ) -> ViewOutput {
         let (w, h) = (cam.width(), cam.height());
         let rays = cam.view_rays(view);
+        let shading = shading.seen_from(grid_position(cam, view));
         let bands: Vec<Band> = (0..h.div_ceil(BAND_ROWS))
             .into_par_iter()
             .map_init(
@@ -230,6 +235,12 @@ impl RenderScene {
             .collect();
         assemble(w as usize, h as usize, bands, with_gt)
     }
+}
+
+/// The position of `view` in the camera grid, in view steps from the centre view.
+fn grid_position(cam: &LightFieldCamera, view: u32) -> Vec2 {
+    let (u, v) = cam.view_offset(view);
+    Vec2::new(u as f32, v as f32)
 }
 
 /// Joins bands (in row order) into the view's image and ground truth.
