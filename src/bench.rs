@@ -121,8 +121,11 @@ fn time(f: impl FnOnce()) -> f64 {
 
 /// Image side of the quality benchmark's views (the size of the measurements in issue #14).
 const QUALITY_RES: u32 = 128;
-/// Samples per pixel of the converged independent reference.
+/// Samples per pixel of the converged independent reference (two halves of its own seeds).
 const REFERENCE_SPP: u32 = 1024;
+/// Salt of the reference halves' seeds (the scene seed's), so they share no samples with the
+/// renders they score.
+const REFERENCE_SALT: u64 = 0x2EF0;
 
 /// `lfgen bench --quality`: for built-in scenes `scenes` at 128², the centre view of the
 /// configured settings, shared and independent side by side, against a converged independent
@@ -134,7 +137,8 @@ pub fn quality(cfg: &Config, scenes: &[u64], images: Option<&Path>) -> Result<()
     let mut cfg = cfg.clone();
     cfg.camera.resolution = [QUALITY_RES, QUALITY_RES];
     println!(
-        "scene | shading | PSNR linear dB | PSNR 8-bit dB | photo residual (8-bit levels) | s per scene"
+        "scene | shading | PSNR linear dB: vs reference (vs truth) | PSNR 8-bit dB: vs reference \
+         (vs truth) | photo residual (8-bit levels) | s per scene"
     );
     for &index in scenes {
         let (desc, scene) = generate_scene(&cfg, index, None)?;
@@ -142,14 +146,46 @@ pub fn quality(cfg: &Config, scenes: &[u64], images: Option<&Path>) -> Result<()
         let center = cam.center_view();
         let counter = AtomicU64::new(0);
         let mut job = RenderJob::from_config(&cfg, "");
-        let converged = RenderSettings {
-            spp: REFERENCE_SPP,
-            gt_spp: REFERENCE_SPP,
+        // The reference from its own seeds, as two halves: their difference measures its noise.
+        let converged = |salt: u64, spp: u32| RenderSettings {
+            spp,
+            gt_spp: spp,
+            seed: desc.seed ^ salt,
             ..job.settings(&desc)
         };
-        let reference = scene.render_view(cam, &desc.slices, &converged, center, true, &counter);
-        let exposure = desc.exposure * auto_exposure(&reference.image.pixels);
+        let [a, b] = [REFERENCE_SALT, REFERENCE_SALT + 1].map(|salt| {
+            let s = converged(salt, REFERENCE_SPP / 2);
+            scene.render_view(
+                cam,
+                &desc.slices,
+                &s,
+                center,
+                salt == REFERENCE_SALT,
+                &counter,
+            )
+        });
+        let (a_px, b_px) = (&a.image.pixels, &b.image.pixels);
+        let reference: Vec<Vec3> = a_px
+            .iter()
+            .zip(b_px)
+            .map(|(x, y)| (*x + *y) * 0.5)
+            .collect();
+        let exposure = desc.exposure * auto_exposure(&reference);
         let tone = cfg.render.tone_curve;
+        let own_noise = [
+            reference_noise(mse_linear(a_px, b_px, exposure)),
+            reference_noise(mse_8bit(a_px, b_px, exposure, tone)),
+        ];
+        let score = |img: &[Vec3]| {
+            let mse = [
+                mse_linear(img, &reference, exposure),
+                mse_8bit(img, &reference, exposure, tone),
+            ];
+            let peak = [1.0, 255.0 * 255.0];
+            let psnr = |k: usize, mse: f64| 10.0 * (peak[k] / mse).log10();
+            let truth = |k: usize| psnr(k, mse_to_truth(mse[k], own_noise[k]));
+            [0, 1].map(|k| format!("{:.1} ({:.1})", psnr(k, mse[k]), truth(k)))
+        };
         let [w, h] = cam.resolution.map(|n| n as usize);
         let write = |name: &str, pixels: &[Vec3]| -> Result<()> {
             let Some(dir) = images else { return Ok(()) };
@@ -157,17 +193,23 @@ pub fn quality(cfg: &Config, scenes: &[u64], images: Option<&Path>) -> Result<()
             write_linear_exr(&path.with_extension("exr"), w, h, pixels)?;
             write_png(&path.with_extension("png"), w, h, pixels, exposure, tone)
         };
-        write("reference", &reference.image.pixels)?;
-        let gt = reference.gt.as_ref().expect("reference has GT");
+        write("reference", &reference)?;
+        let gt = a.gt.as_ref().expect("the reference has GT");
         let disparity: Vec<f32> = (gt.hci_depth.iter())
             .map(|&z| cam.disparity(z as f64) as f32)
             .collect();
         // The residual of two converged views: its floor, from resampling alone (texture detail
         // finer than a pixel does not survive the bilinear lookup of the shifted view).
-        let adjacent =
-            scene.render_view(cam, &desc.slices, &converged, center + 1, false, &counter);
+        let adjacent = scene.render_view(
+            cam,
+            &desc.slices,
+            &converged(REFERENCE_SALT, REFERENCE_SPP),
+            center + 1,
+            false,
+            &counter,
+        );
         let floor = photo_residual(
-            &reference.image.pixels,
+            &reference,
             &adjacent.image.pixels,
             &disparity,
             &gt.modes,
@@ -175,7 +217,13 @@ pub fn quality(cfg: &Config, scenes: &[u64], images: Option<&Path>) -> Result<()
             exposure,
             tone,
         );
-        println!("{index} | converged ({REFERENCE_SPP} spp) | – | – | {floor:.2} | –");
+        let [own_linear, own_8bit] = [10.0 * (1.0 / own_noise[0]).log10(), {
+            10.0 * (255.0f64 * 255.0 / own_noise[1]).log10()
+        }];
+        println!(
+            "{index} | converged ({REFERENCE_SPP} spp) | ({own_linear:.1}) | ({own_8bit:.1}) | \
+             {floor:.2} | –"
+        );
         for shading in [ShadingMode::Shared, ShadingMode::Independent] {
             job.shading = shading;
             let settings = job.settings(&desc);
@@ -208,10 +256,9 @@ pub fn quality(cfg: &Config, scenes: &[u64], images: Option<&Path>) -> Result<()
             let (adjacent, _) = render(center + 1);
             let scene_s = fill + t_view * cam.num_views() as f64;
             write(&format!("{shading:?}").to_lowercase(), &c)?;
+            let [linear, eight_bit] = score(&c);
             println!(
-                "{index} | {shading:?} | {:.1} | {:.1} | {:.2} | {scene_s:.1}",
-                psnr_linear(&c, &reference.image.pixels, exposure),
-                psnr_8bit(&c, &reference.image.pixels, exposure, tone),
+                "{index} | {shading:?} | {linear} | {eight_bit} | {:.2} | {scene_s:.1}",
                 photo_residual(&c, &adjacent, &disparity, &gt.modes, [w, h], exposure, tone),
             );
         }
@@ -219,23 +266,35 @@ pub fn quality(cfg: &Config, scenes: &[u64], images: Option<&Path>) -> Result<()
     Ok(())
 }
 
-/// PSNR of exposure-scaled linear radiance, peak 1 (display white).
-fn psnr_linear(a: &[Vec3], reference: &[Vec3], exposure: f32) -> f64 {
-    let mse = (a.iter().zip(reference))
-        .map(|(&x, &r)| ((x - r) * exposure).length_squared() as f64 / 3.0)
-        .sum::<f64>()
-        / a.len() as f64;
-    -10.0 * mse.log10()
+/// The reference's own mean squared error against the truth, from the squared difference
+/// of its two independent halves: each half has twice the variance of their mean, and they
+/// differ by the sum of theirs, four times it.
+fn reference_noise(mse_between_halves: f64) -> f64 {
+    mse_between_halves / 4.0
 }
 
-/// PSNR of the 8-bit sRGB images the PNGs hold.
-fn psnr_8bit(a: &[Vec3], reference: &[Vec3], exposure: f32, tone: ToneCurve) -> f64 {
+/// An image's mean squared error against the truth, from its error against a noisy but
+/// unbiased reference of independent noise `reference_noise`: the two add up. Never below a
+/// thousandth of the measured error (a noisy estimate may subtract more than is there).
+fn mse_to_truth(mse_vs_reference: f64, reference_noise: f64) -> f64 {
+    (mse_vs_reference - reference_noise).max(1e-3 * mse_vs_reference)
+}
+
+/// Mean squared error of exposure-scaled linear radiance (PSNR peak 1: display white).
+fn mse_linear(a: &[Vec3], reference: &[Vec3], exposure: f32) -> f64 {
+    (a.iter().zip(reference))
+        .map(|(&x, &r)| ((x - r) * exposure).length_squared() as f64 / 3.0)
+        .sum::<f64>()
+        / a.len() as f64
+}
+
+/// Mean squared error of the 8-bit images the PNGs hold.
+fn mse_8bit(a: &[Vec3], reference: &[Vec3], exposure: f32, tone: ToneCurve) -> f64 {
     let (a, r) = (tone.encode(a, exposure), tone.encode(reference, exposure));
-    let mse = (a.iter().zip(&r))
+    (a.iter().zip(&r))
         .map(|(&x, &y)| (x as f64 - y as f64).powi(2))
         .sum::<f64>()
-        / a.len() as f64;
-    10.0 * (255.0f64 * 255.0 / mse).log10()
+        / a.len() as f64
 }
 
 /// Mean 8-bit difference between the centre view and the adjacent view (one column to the
@@ -277,4 +336,43 @@ fn photo_residual(
         }
     }
     sum / n.max(1) as f64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+
+    /// Against independent truth: a constant image, a reference made of two halves with
+    /// uniform noise, and a test image with noise of known variance.
+    #[test]
+    fn the_error_against_the_truth_is_recovered_from_a_noisy_reference() {
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
+        let n = 200_000;
+        let truth = Vec3::splat(0.5);
+        // U(−a, a) has variance a²/3.
+        let mut noisy = |a: f32| -> Vec<Vec3> {
+            (0..n)
+                .map(|_| truth + Vec3::splat(rng.random_range(-a..a)))
+                .collect()
+        };
+        let (half_a, half_b) = (noisy(0.2), noisy(0.2));
+        let test = noisy(0.1);
+        let reference: Vec<Vec3> = (half_a.iter().zip(&half_b))
+            .map(|(a, b)| (*a + *b) * 0.5)
+            .collect();
+        let own = reference_noise(mse_linear(&half_a, &half_b, 1.0));
+        assert!((own - 0.04 / 3.0 / 2.0).abs() < 1e-4, "{own}");
+        let measured = mse_linear(&test, &reference, 1.0);
+        let recovered = mse_to_truth(measured, own);
+        let exact = 0.01 / 3.0;
+        assert!(
+            (recovered - exact).abs() < 0.02 * exact,
+            "{recovered} vs {exact}"
+        );
+        assert!(
+            measured > 2.0 * exact,
+            "the uncorrected error is far off: {measured}"
+        );
+    }
 }
