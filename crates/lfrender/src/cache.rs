@@ -322,9 +322,24 @@ pub struct Cached {
     pub glossy: Option<GlossyFit>,
 }
 
+/// The last [`MEMO`] corner sets a thread looked up, replaced round-robin: a composited
+/// camera ray alternates between the layers it passes (a lampshade, the bulb behind it), so
+/// one remembered set would be evicted at every lookup.
+struct CornerMemo {
+    sets: [Option<(Corners, [Option<Cell>; 8])>; MEMO],
+    next: usize,
+}
+
+/// Corner sets remembered per thread.
+const MEMO: usize = 4;
+
 thread_local! {
-    static LAST_CORNERS: std::cell::RefCell<Option<(Corners, [Option<Cell>; 8])>> =
-        const { std::cell::RefCell::new(None) };
+    static LAST_CORNERS: std::cell::RefCell<CornerMemo> = const {
+        std::cell::RefCell::new(CornerMemo {
+            sets: [None; MEMO],
+            next: 0,
+        })
+    };
 }
 
 /// The filled cache: the mean estimates per cell.
@@ -379,7 +394,7 @@ impl RadianceCache {
     }
 
     /// The eight cells around a lookup. The samples of a pixel (and of its neighbours) mostly
-    /// fall between the same eight cells, so the last eight are kept per thread: at 512²
+    /// fall between the same eight cells, so the last few sets are kept per thread: at 512²
     /// the table is far larger than the CPU caches, and eight random reads per sample cost
     /// more than the rest of the sample.
     fn corners(&self, level: i32, base: I64Vec3, n: Vec3, material: u32) -> [Option<Cell>; 8] {
@@ -391,11 +406,10 @@ impl RadianceCache {
             normal: (axis as u8) << 1 | (n[axis] < 0.0) as u8,
             material,
         };
-        LAST_CORNERS.with(|last| {
-            let mut last = last.borrow_mut();
-            if let Some((seen, values)) = &*last
-                && *seen == id
-            {
+        LAST_CORNERS.with(|memo| {
+            let mut memo = memo.borrow_mut();
+            let seen = memo.sets.iter().flatten().find(|(seen, _)| *seen == id);
+            if let Some((_, values)) = seen {
                 return *values;
             }
             let values = std::array::from_fn(|corner| {
@@ -403,7 +417,9 @@ impl RadianceCache {
                 let o = I64Vec3::new(c & 1, (c >> 1) & 1, c >> 2);
                 self.get(self.grid.cell_key(level, base + o, n, material))
             });
-            *last = Some((id, values));
+            let slot = memo.next;
+            memo.sets[slot] = Some((id, values));
+            memo.next = (slot + 1) % MEMO;
             values
         })
     }

@@ -24,6 +24,10 @@ struct IsectTri {
     n: Vec3A,
 }
 
+/// Relative distance within which two hits on one object are one surface (shared edges,
+/// split leaves report the same crossing twice).
+const SAME_SURFACE: f32 = 1e-5;
+
 /// Shading data of one triangle, in BVH leaf order.
 #[derive(Clone, Copy, Debug)]
 pub struct TriShading {
@@ -199,16 +203,22 @@ impl Geometry {
             .unwrap_or_else(|| m.opacity.eval(self.uv(hit)))
     }
 
+    /// The opacity stochastic transparency tests a hit with (a leaf's uniform opacity where
+    /// it has one).
+    #[inline]
+    pub fn hit_opacity(&self, mats: &[RenderMaterial], hit: &Hit) -> f32 {
+        let uniform = self.leaf_opacity[hit.tri as usize];
+        match uniform.is_nan() {
+            true => self.opacity(mats, hit),
+            false => uniform,
+        }
+    }
+
     /// Whether the stochastic-transparency test keeps this hit. The decision hashes the ray's
     /// `key` with the triangle, so the same ray sees the same surfaces whichever query asks.
     #[inline]
     pub fn accepts(&self, mats: &[RenderMaterial], hit: &Hit, key: RayKey) -> bool {
-        let uniform = self.leaf_opacity[hit.tri as usize];
-        let a = if uniform.is_nan() {
-            self.opacity(mats, hit)
-        } else {
-            uniform
-        };
+        let a = self.hit_opacity(mats, hit);
         a >= 1.0 || (a > 0.0 && key.uniform(self.shading[hit.tri as usize].id) < a)
     }
 
@@ -221,6 +231,33 @@ impl Geometry {
         tmax: f32,
         key: RayKey,
     ) -> Option<Hit> {
+        self.closest_where(origin, dir, 0.0, tmax, |hit| self.accepts(mats, hit, key))
+    }
+
+    /// The first surface with any opacity behind `after` (from the origin for `None`): the
+    /// next layer of a ray that composites semi-transparent surfaces. Hits within
+    /// [`SAME_SURFACE`] behind `after` are skipped: one crossing reported twice.
+    pub fn next_layer(
+        &self,
+        mats: &[RenderMaterial],
+        origin: Vec3,
+        dir: Vec3,
+        after: Option<&Hit>,
+    ) -> Option<Hit> {
+        let tmin = after.map_or(0.0, |h| h.t + SAME_SURFACE * h.t.max(1.0));
+        let visible = |hit: &Hit| self.hit_opacity(mats, hit) > 0.0;
+        self.closest_where(origin, dir, tmin, f32::INFINITY, visible)
+    }
+
+    /// Closest hit in `[tmin, tmax)` that `accept` keeps.
+    fn closest_where(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        tmin: f32,
+        tmax: f32,
+        accept: impl Fn(&Hit) -> bool,
+    ) -> Option<Hit> {
         let ray = Ray::new(origin.into(), dir.into(), 0.0, tmax);
         let mut best = Hit {
             t: f32::INFINITY,
@@ -230,13 +267,13 @@ impl Geometry {
         let mut rh = RayHit::none();
         self.bvh.ray_traverse(ray, &mut rh, |r, leaf| {
             let (t, b) = self.intersect(r, leaf);
-            if t < best.t {
+            if t < best.t && t >= tmin {
                 let hit = Hit {
                     t,
                     tri: leaf as u32,
                     b,
                 };
-                if self.accepts(mats, &hit, key) {
+                if accept(&hit) {
                     best = hit;
                     return t;
                 }
@@ -264,7 +301,7 @@ impl Geometry {
         out.sort_unstable_by(|a, b| a.t.total_cmp(&b.t).then(a.tri.cmp(&b.tri)));
         out.dedup_by(|b, a| {
             let (sa, sb) = (&self.shading[a.tri as usize], &self.shading[b.tri as usize]);
-            sa.id == sb.id || (sa.object == sb.object && (b.t - a.t) <= 1e-5 * a.t.max(1.0))
+            sa.id == sb.id || (sa.object == sb.object && (b.t - a.t) <= SAME_SURFACE * a.t.max(1.0))
         });
     }
 
