@@ -10,7 +10,7 @@ use crate::render::RenderScene;
 use crate::render::cache::CacheParams;
 use crate::render::framing::auto_exposure;
 use crate::render::integrator::{PathSettings, Shading};
-use crate::render::view::{RenderSettings, ViewOutput};
+use crate::render::view::{RenderSettings, ViewOutput, gt_own_spp};
 use crate::scene::SceneDesc;
 use crate::scene::assets::Assets;
 use crate::stats::SceneStats;
@@ -89,11 +89,7 @@ impl RenderJob {
             GtViews::All => views,
             GtViews::Center => 1,
         };
-        let gt_own = if self.gt_spp == self.spp {
-            0
-        } else {
-            self.gt_spp
-        };
+        let gt_own = gt_own_spp(self.spp, self.gt_spp);
         views as u64 * (self.spp + fill) as u64 + gt_views as u64 * gt_own as u64
     }
 

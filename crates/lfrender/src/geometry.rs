@@ -309,7 +309,7 @@ impl Geometry {
     /// `1 - opacity` over semi-transparent surfaces; opaque surfaces block. Smooth glass blocks
     /// too, unless `through_glass`: then each glass interface passes its tint times
     /// `1 − Fresnel` along the straight line (no refraction; see `GlassLight::Shadows`). Also
-    /// says whether the segment crossed glass.
+    /// says whether the segment crossed glass. `dir` is a unit vector (shadow rays).
     pub fn transmittance(
         &self,
         mats: &[RenderMaterial],
@@ -345,11 +345,11 @@ impl Geometry {
         (if clear { tr } else { Vec3::ZERO }, crossed_glass)
     }
 
-    /// What one glass interface passes of light crossing it along `dir`: its tint times
+    /// What one glass interface passes of light crossing it along unit `dir`: its tint times
     /// `1 − F`, with F the Fresnel reflectance for the side the ray enters from (total internal
     /// reflection passes nothing).
     fn glass_transmittance(&self, m: &RenderMaterial, hit: &Hit, dir: Vec3, ior: f32) -> Vec3 {
-        let cos = dir.normalize().dot(self.geometric_normal(hit.tri));
+        let cos = dir.dot(self.geometric_normal(hit.tri));
         let eta = if cos < 0.0 { ior } else { 1.0 / ior };
         let (reflected, _) = super::bsdf::fresnel_dielectric(cos.abs(), eta);
         m.base_color.eval(self.uv(hit)) * (1.0 - reflected).max(0.0)

@@ -35,11 +35,19 @@ pub struct RenderSettings {
 impl RenderSettings {
     /// Camera samples per pixel of a view: the colour's, plus the GT's own where it has them.
     pub fn samples_per_pixel(&self, with_gt: bool) -> u32 {
-        match with_gt && self.gt_spp != self.spp {
-            true => self.spp + self.gt_spp,
-            false => self.spp,
-        }
+        self.spp
+            + if with_gt {
+                gt_own_spp(self.spp, self.gt_spp)
+            } else {
+                0
+            }
     }
+}
+
+/// The camera samples a GT view traces for its ground truth on top of the colour's: none when
+/// `gt_spp == spp` (the colour's own rays carry the GT), else `gt_spp` of their own.
+pub fn gt_own_spp(spp: u32, gt_spp: u32) -> u32 {
+    if gt_spp == spp { 0 } else { gt_spp }
 }
 
 /// Linear radiance, row-major from the top-left.
@@ -299,7 +307,7 @@ impl PixelCtx<'_> {
     fn render(&self, with_gt: bool, scratch: &mut Scratch, band: &mut Band) {
         let s = self.settings;
         // The colour's rays carry the GT too, unless the GT has its own sample count.
-        let gt_inline = with_gt && s.gt_spp == s.spp;
+        let gt_inline = with_gt && gt_own_spp(s.spp, s.gt_spp) == 0;
         if with_gt {
             let (centre, geo) = (self.centre, &self.scene.geometry);
             geo.all_hits(
