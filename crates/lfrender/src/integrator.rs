@@ -64,7 +64,8 @@ struct Arrival {
 pub enum Shading<'a> {
     /// Every lobe traced by every path: the reference estimator.
     Independent,
-    /// Estimate the coupled irradiance there and end: one sample for the shared cache.
+    /// Estimate the coupled irradiance there, or where the lobe is shared the glossy term
+    /// (see [`super::cache`]), and end: one sample for the shared cache.
     Fill(&'a CacheGrid),
     /// Diffuse light from the cache; the glossy lobe too where the cache shares it, else
     /// traced by this path. `view`: the view's position in the grid ([`Shading::seen_from`]).
