@@ -79,37 +79,51 @@ pub fn run(cfg: &Config) -> Result<()> {
     let job = RenderJob::from_config(&cfg, "");
     let settings = job.settings(&desc);
     let counter = AtomicU64::new(0);
-    let render = |gt: bool| {
-        time(|| {
-            drop(scene.render_view(
-                cam,
-                &desc.slices,
-                &settings,
-                cam.center_view(),
-                gt,
-                &counter,
-            ))
-        })
-    };
-    // Alternate and keep the best of three to damp the noise of a shared machine.
-    let (mut colour, mut with_gt) = (f64::INFINITY, f64::INFINITY);
-    for _ in 0..3 {
-        colour = colour.min(render(false));
-        with_gt = with_gt.min(render(true));
-    }
+    // The configured shading's cache, filled once (its cost is the scene's, not the GT's).
+    let cache = (job.shading == ShadingMode::Shared).then(|| {
+        let fill_spp = job.fill_spp(cam.num_views());
+        scene.fill_cache(cam, &settings, fill_spp, job.cache, &counter)
+    });
+    let configured = cache.as_ref().map_or(Shading::Independent, Shading::read);
     let samples = (pixels.len() as u64 * cfg.render.spp as u64) as f64;
-    println!(
-        "colour only: {:.3} s ({:.0} camera samples/s)",
-        colour,
-        samples / colour
-    );
-    println!(
-        "colour + {}-slice GT: {:.3} s ({:.0} camera samples/s)",
-        cfg.render.slices,
-        with_gt,
-        samples / with_gt
-    );
-    println!("gt_overhead_ratio: {:.3}", with_gt / colour);
+    let mut ratio = 0.0;
+    let configured_name = format!("{:?}", job.shading).to_lowercase();
+    let rows = [
+        ("independent", Shading::Independent),
+        (&configured_name, configured),
+    ];
+    for (name, shading) in rows {
+        let render = |gt: bool| {
+            time(|| {
+                let view = cam.center_view();
+                drop(scene.render_view_with(
+                    cam,
+                    &desc.slices,
+                    &settings,
+                    view,
+                    gt,
+                    shading,
+                    &counter,
+                ))
+            })
+        };
+        // Alternate and keep the best of three to damp the noise of a shared machine.
+        let (mut colour, mut with_gt) = (f64::INFINITY, f64::INFINITY);
+        for _ in 0..3 {
+            colour = colour.min(render(false));
+            with_gt = with_gt.min(render(true));
+        }
+        println!(
+            "{name} shading: colour only {colour:.3} s ({:.0} camera samples/s); colour + \
+             {}-slice GT {with_gt:.3} s ({:.0} camera samples/s): ratio {:.3}",
+            samples / colour,
+            cfg.render.slices,
+            samples / with_gt,
+            with_gt / colour
+        );
+        ratio = with_gt / colour;
+    }
+    println!("gt_overhead_ratio: {ratio:.3}");
     Ok(())
 }
 
