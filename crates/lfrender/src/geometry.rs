@@ -249,7 +249,7 @@ impl Geometry {
         self.closest_where(origin, dir, tmin, f32::INFINITY, visible)
     }
 
-    /// Closest hit in `[tmin, tmax)` that `accept` keeps.
+    /// Closest hit in `(tmin, tmax]` that `accept` keeps.
     fn closest_where(
         &self,
         origin: Vec3,
@@ -258,7 +258,7 @@ impl Geometry {
         tmax: f32,
         accept: impl Fn(&Hit) -> bool,
     ) -> Option<Hit> {
-        let ray = Ray::new(origin.into(), dir.into(), 0.0, tmax);
+        let ray = Ray::new(origin.into(), dir.into(), tmin, tmax);
         let mut best = Hit {
             t: f32::INFINITY,
             tri: 0,
@@ -267,7 +267,7 @@ impl Geometry {
         let mut rh = RayHit::none();
         self.bvh.ray_traverse(ray, &mut rh, |r, leaf| {
             let (t, b) = self.intersect(r, leaf);
-            if t < best.t && t >= tmin {
+            if t < best.t {
                 let hit = Hit {
                     t,
                     tri: leaf as u32,

@@ -429,15 +429,17 @@ impl PixelCtx<'_> {
         for (i, h) in scratch.hits.iter().enumerate() {
             let shaded = match self.settings.shade_all_hits {
                 true if Some(i) == first => Some(radiance),
-                true if first.is_none() && layer(h).is_some() => layer(h).map(|l| l.1),
-                // Hidden surfaces draw from their own stream so the colour image stays the same.
-                true => Some(scene.radiance(
-                    path,
-                    origin,
-                    dir,
-                    Some(*h),
-                    &mut Sampler::from_key(key.stream() ^ i as u64),
-                )),
+                // A composited layer was shaded already; hidden surfaces draw from their own
+                // stream so the colour image stays the same.
+                true => layer(h).map(|l| l.1).or_else(|| {
+                    Some(scene.radiance(
+                        path,
+                        origin,
+                        dir,
+                        Some(*h),
+                        &mut Sampler::from_key(key.stream() ^ i as u64),
+                    ))
+                }),
                 false => None,
             };
             let slice = self.slice_of(h, centre.origin, centre.dir, centre_hits);
