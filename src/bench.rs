@@ -133,26 +133,25 @@ fn time(f: impl FnOnce()) -> f64 {
     t.elapsed().as_secs_f64()
 }
 
-/// Image side of the quality benchmark's views (the size of the measurements in issue #14).
-const QUALITY_RES: u32 = 128;
 /// Samples per pixel of the converged independent reference (two halves of its own seeds).
 const REFERENCE_SPP: u32 = 1024;
 /// Salt of the reference halves' seeds (the scene seed's), so they share no samples with the
 /// renders they score.
 const REFERENCE_SALT: u64 = 0x2EF0;
 
-/// `lfgen bench --quality`: for built-in scenes `scenes` at 128², the centre view of the
+/// `lfgen bench --quality`: for built-in scenes `scenes` at `size`², the centre view of the
 /// configured settings, shared and independent side by side, against a converged independent
 /// render: PSNR, the photo-consistency residual of the adjacent view, and the time.
-pub fn quality(cfg: &Config, scenes: &[u64], images: Option<&Path>) -> Result<()> {
+pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -> Result<()> {
     if let Some(dir) = images {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     }
     let mut cfg = cfg.clone();
-    cfg.camera.resolution = [QUALITY_RES, QUALITY_RES];
+    cfg.camera.resolution = [size, size];
     println!(
         "scene | shading | PSNR linear dB: vs reference (vs truth) | PSNR 8-bit dB: vs reference \
-         (vs truth) | photo residual (8-bit levels) | s per scene"
+         (vs truth) | photo residual (8-bit levels) | s per scene | per-view noise share: \
+         linear / 8-bit"
     );
     for &index in scenes {
         let (desc, scene) = generate_scene(&cfg, index, None)?;
@@ -271,13 +270,45 @@ pub fn quality(cfg: &Config, scenes: &[u64], images: Option<&Path>) -> Result<()
             let scene_s = fill + t_view * cam.num_views() as f64;
             write(&format!("{shading:?}").to_lowercase(), &c)?;
             let [linear, eight_bit] = score(&c);
+            // The centre view again from other camera seeds but the same cache: the two
+            // differ only by the noise that is the view's own.
+            let again = RenderSettings {
+                seed: settings.seed ^ PER_VIEW_SALT,
+                ..settings
+            };
+            let again =
+                (scene.render_view_with(cam, &desc.slices, &again, center, false, mode, &counter))
+                    .image
+                    .pixels;
+            write(&format!("{shading:?}_again").to_lowercase(), &again)?;
+            let share = |k: usize| {
+                let mse = |a: &[Vec3], b: &[Vec3]| match k {
+                    0 => mse_linear(a, b, exposure),
+                    _ => mse_8bit(a, b, exposure, tone),
+                };
+                let to_truth = mse_to_truth(mse(&c, &reference), own_noise[k]);
+                100.0 * per_view_share(mse(&c, &again), to_truth)
+            };
             println!(
-                "{index} | {shading:?} | {linear} | {eight_bit} | {:.2} | {scene_s:.1}",
+                "{index} | {shading:?} | {linear} | {eight_bit} | {:.2} | {scene_s:.1} | {:.0} % / {:.0} %",
                 photo_residual(&c, &adjacent, &disparity, &gt.modes, [w, h], exposure, tone),
+                share(0),
+                share(1),
             );
         }
     }
     Ok(())
+}
+
+/// Salt of the second render of a view that measures its own noise ([`per_view_share`]).
+const PER_VIEW_SALT: u64 = 0x005E_C04D;
+
+/// The share of a render's error against the truth that is its view's own noise, from the
+/// squared difference of two renders that differ only in their camera seeds: shared shading's
+/// two renders read the same cache, so they differ by twice the per-view noise's variance; the
+/// rest of the error (the cache's noise and bias) is common to both and to every view.
+fn per_view_share(mse_between_renders: f64, mse_vs_truth: f64) -> f64 {
+    (mse_between_renders / 2.0 / mse_vs_truth).min(1.0)
 }
 
 /// The reference's own mean squared error against the truth, from the squared difference
@@ -388,5 +419,25 @@ mod tests {
             measured > 2.0 * exact,
             "the uncorrected error is far off: {measured}"
         );
+    }
+
+    /// Two renders with a common error (a fixed offset per pixel, as a shared cache's) and
+    /// noise of their own: the noise's share of the error is recovered.
+    #[test]
+    fn the_per_view_share_of_the_error_is_recovered() {
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(11);
+        let n = 200_000;
+        let common: Vec<f32> = (0..n).map(|_| rng.random_range(-0.1f32..0.1)).collect();
+        let mut render = || -> Vec<Vec3> {
+            (common.iter())
+                .map(|&c| Vec3::splat(0.5 + c + rng.random_range(-0.2f32..0.2)))
+                .collect()
+        };
+        let (a, b) = (render(), render());
+        let truth = vec![Vec3::splat(0.5); n];
+        // Per-view variance 0.04 / 3, common 0.01 / 3: the noise is 80 % of the error.
+        let share = per_view_share(mse_linear(&a, &b, 1.0), mse_linear(&a, &truth, 1.0));
+        assert!((share - 0.8).abs() < 0.01, "{share}");
+        assert_eq!(per_view_share(2.0, 0.5), 1.0, "never above the whole error");
     }
 }

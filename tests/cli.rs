@@ -402,3 +402,41 @@ fn rays_through_windows_and_doors_end_on_a_surface() {
     }
     assert_eq!(seen, [true, true], "windows and doors");
 }
+
+/// `lfgen bench --quality` end to end at a tiny size: the converged row and both shadings, each
+/// with the share of its error that is its view's own noise. The independent estimator has no
+/// shared part, so all of its error is its own: at 128² the bench finds 100 % (linear); on
+/// 576 pixels a few fireflies make the estimate itself noisy (68 % here), while a second render
+/// that repeated the first one's samples would give 0 %. An image size below the bench's
+/// minimum is refused by name.
+#[test]
+fn the_quality_bench_scores_both_shadings_with_their_error_budget() {
+    let images = tmp();
+    let dir = images.path().to_str().unwrap();
+    let args = ["bench", "--quality", "--size", "24", "--scenes", "0"];
+    let out = ok(lfgen(&args, &["--images", dir, "-q"]));
+    let table = String::from_utf8_lossy(&out.stdout).into_owned();
+    let row = |name: &str| -> Vec<String> {
+        let line = (table.lines())
+            .find(|l| l.starts_with(&format!("0 | {name}")))
+            .unwrap_or_else(|| panic!("no {name} row in:\n{table}"));
+        line.split(" | ").map(str::to_owned).collect()
+    };
+    assert!(row("converged").len() >= 5, "{table}");
+    let share = |cells: &[String]| -> f64 {
+        let linear = cells[6].split(" % / ").next().unwrap();
+        linear
+            .parse()
+            .unwrap_or_else(|_| panic!("share {:?}", cells[6]))
+    };
+    let independent = row("Independent");
+    assert!(share(&independent) >= 50.0, "{table}");
+    assert!((0.0..=100.0).contains(&share(&row("Shared"))), "{table}");
+    for name in ["reference", "shared", "shared_again", "independent"] {
+        let path = images.path().join(format!("scene0_{name}.png"));
+        assert!(path.exists(), "{} missing", path.display());
+    }
+    let small = lfgen(&["bench", "--quality", "--size", "8"], &[]);
+    assert!(!small.status.success());
+    assert!(stderr(&small).contains("--size"), "{}", stderr(&small));
+}
