@@ -729,6 +729,29 @@ mod tests {
         assert_eq!(cfg.augment.max_downscale, 1);
     }
 
+    /// The field recipe differs from cpu_small only in depth, and its field reaches a point at
+    /// 3.5 px in the outer views of a 9×9 grid (4 steps × 3.5 px = 14 px).
+    #[test]
+    fn the_field_recipe_reaches_the_outer_views() {
+        let small: TrainConfig = toml::from_str(include_str!("../configs/cpu_small.toml")).unwrap();
+        let field: TrainConfig = toml::from_str(include_str!("../configs/cpu_field.toml")).unwrap();
+        field.validate().unwrap();
+        assert!(small.net.receptive_radius() < 14);
+        assert_eq!(field.net.receptive_radius(), 14);
+        let deeper = NetConfig {
+            stream_blocks: 4,
+            head_blocks: 9,
+            ..small.net
+        };
+        assert_eq!(
+            field,
+            TrainConfig {
+                net: deeper,
+                ..small
+            }
+        );
+    }
+
     #[test]
     fn ese_passes_are_symmetric_by_default_or_span_a_range() {
         let ese = EseConfig::default();
