@@ -189,11 +189,10 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
             reference_noise(mse_linear(a_px, b_px, exposure)),
             reference_noise(mse_8bit(a_px, b_px, exposure, tone)),
         ];
-        let score = |img: &[Vec3]| {
-            let mse = [
-                mse_linear(img, &reference, exposure),
-                mse_8bit(img, &reference, exposure, tone),
-            ];
+        // Linear and 8-bit mean squared differences of two images.
+        let mse =
+            |a: &[Vec3], b: &[Vec3]| [mse_linear(a, b, exposure), mse_8bit(a, b, exposure, tone)];
+        let score = |mse: [f64; 2]| {
             let peak = [1.0, 255.0 * 255.0];
             let psnr = |k: usize, mse: f64| 10.0 * (peak[k] / mse).log10();
             let truth = |k: usize| psnr(k, mse_to_truth(mse[k], own_noise[k]));
@@ -252,12 +251,12 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
             });
             let fill = started.elapsed().as_secs_f64();
             let mode = cache.as_ref().map_or(Shading::Independent, Shading::read);
-            let render = |view| {
+            let render = |settings: &RenderSettings, view| {
                 let t = Instant::now();
                 let out = scene.render_view_with(
                     cam,
                     &desc.slices,
-                    &settings,
+                    settings,
                     view,
                     false,
                     mode,
@@ -265,29 +264,21 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
                 );
                 (out.image.pixels, t.elapsed().as_secs_f64())
             };
-            let (c, t_view) = render(center);
-            let (adjacent, _) = render(center + 1);
+            let (c, t_view) = render(&settings, center);
+            let (adjacent, _) = render(&settings, center + 1);
             let scene_s = fill + t_view * cam.num_views() as f64;
             write(&format!("{shading:?}").to_lowercase(), &c)?;
-            let [linear, eight_bit] = score(&c);
+            let to_reference = mse(&c, &reference);
+            let [linear, eight_bit] = score(to_reference);
             // The centre view again from other camera seeds but the same cache: the two
             // differ only by the noise that is the view's own.
-            let again = RenderSettings {
-                seed: settings.seed ^ PER_VIEW_SALT,
-                ..settings
-            };
-            let again =
-                (scene.render_view_with(cam, &desc.slices, &again, center, false, mode, &counter))
-                    .image
-                    .pixels;
+            let seed = settings.seed ^ PER_VIEW_SALT;
+            let (again, _) = render(&RenderSettings { seed, ..settings }, center);
             write(&format!("{shading:?}_again").to_lowercase(), &again)?;
+            let between = mse(&c, &again);
             let share = |k: usize| {
-                let mse = |a: &[Vec3], b: &[Vec3]| match k {
-                    0 => mse_linear(a, b, exposure),
-                    _ => mse_8bit(a, b, exposure, tone),
-                };
-                let to_truth = mse_to_truth(mse(&c, &reference), own_noise[k]);
-                100.0 * per_view_share(mse(&c, &again), to_truth)
+                let to_truth = mse_to_truth(to_reference[k], own_noise[k]);
+                100.0 * per_view_share(between[k], to_truth)
             };
             println!(
                 "{index} | {shading:?} | {linear} | {eight_bit} | {:.2} | {scene_s:.1} | {:.0} % / {:.0} %",
