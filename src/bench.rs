@@ -185,13 +185,10 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
             .collect();
         let exposure = desc.exposure * auto_exposure(&reference);
         let tone = cfg.render.tone_curve;
-        let own_noise = [
-            reference_noise(mse_linear(a_px, b_px, exposure)),
-            reference_noise(mse_8bit(a_px, b_px, exposure, tone)),
-        ];
         // Linear and 8-bit mean squared differences of two images.
         let mse =
             |a: &[Vec3], b: &[Vec3]| [mse_linear(a, b, exposure), mse_8bit(a, b, exposure, tone)];
+        let own_noise = mse(a_px, b_px).map(reference_noise);
         let score = |mse: [f64; 2]| {
             let peak = [1.0, 255.0 * 255.0];
             let psnr = |k: usize, mse: f64| 10.0 * (peak[k] / mse).log10();
