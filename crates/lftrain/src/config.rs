@@ -729,7 +729,8 @@ mod tests {
         assert_eq!(cfg.augment.max_downscale, 1);
     }
 
-    /// The field recipe differs from cpu_small only in depth, and its field reaches a point at
+    /// The field recipe differs from cpu_small only in depth and in the thesis' warm-up and
+    /// Adam epsilon (the deeper net stalled without them), and its field reaches a point at
     /// 3.5 px in the outer views of a 9×9 grid (4 steps × 3.5 px = 14 px).
     #[test]
     fn the_field_recipe_reaches_the_outer_views() {
@@ -747,6 +748,8 @@ mod tests {
             field,
             TrainConfig {
                 net: deeper,
+                warmup_steps: 1000,
+                adam_epsilon: 1e-8,
                 ..small
             }
         );
