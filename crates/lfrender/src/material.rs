@@ -124,9 +124,9 @@ impl LibraryTile {
         let t = (uv / self.tile_size_m).fract_gl() * n as f32 - Vec2::splat(0.5);
         let (x0, y0) = (t.x.floor(), t.y.floor());
         let (fx, fy) = (t.x - x0, t.y - y0);
-        // Levels are powers of two, so wrapping is a mask (`rem_euclid` divides, four times
-        // per level, and texture lookups are ~8 % of a render's time).
-        debug_assert!(n.is_power_of_two());
+        // Levels are powers of two (`TEXTURE_PX` is, asserted at compile time), so wrapping is
+        // a mask: `rem_euclid` divides, four times per level, and texture lookups are ~8 % of a
+        // render's time.
         let ix = |x: f32| (x as i64 & (n as i64 - 1)) as usize;
         let (xa, xb, ya, yb) = (ix(x0), ix(x0 + 1.0), ix(y0), ix(y0 + 1.0));
         let at = |x: usize, y: usize| texels[y * n + x];
