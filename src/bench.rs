@@ -80,10 +80,8 @@ pub fn run(cfg: &Config) -> Result<()> {
     let settings = job.settings(&desc);
     let counter = AtomicU64::new(0);
     // The configured shading's cache, filled once (its cost is the scene's, not the GT's).
-    let cache = (job.shading == ShadingMode::Shared).then(|| {
-        let fill_spp = job.fill_spp(cam.num_views());
-        scene.fill_cache(cam, &settings, fill_spp, job.cache, &counter)
-    });
+    let cache = (job.shading == ShadingMode::Shared)
+        .then(|| job.fill_cache(&scene, cam, &settings, &counter));
     let configured = cache.as_ref().map_or(Shading::Independent, Shading::read);
     let samples = (pixels.len() as u64 * cfg.render.spp as u64) as f64;
     let mut ratio = 0.0;
@@ -237,15 +235,8 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
             job.shading = shading;
             let settings = job.settings(&desc);
             let started = Instant::now();
-            let cache = (shading == ShadingMode::Shared).then(|| {
-                scene.fill_cache(
-                    cam,
-                    &settings,
-                    job.fill_spp(cam.num_views()),
-                    job.cache,
-                    &counter,
-                )
-            });
+            let cache = (shading == ShadingMode::Shared)
+                .then(|| job.fill_cache(&scene, cam, &settings, &counter));
             let fill = started.elapsed().as_secs_f64();
             let mode = cache.as_ref().map_or(Shading::Independent, Shading::read);
             let render = |settings: &RenderSettings, view| {

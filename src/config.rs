@@ -195,7 +195,8 @@ pub struct RenderConfig {
     /// Shared shading: fill samples per pixel of every view, at least; raised to
     /// ⌈spp / views⌉ so the cache's noise shrinks with spp (`RenderJob::fill_spp`).
     pub cache_spp: u32,
-    /// Shared shading: cache cell size in pixels of the centre view at the cell's depth.
+    /// Shared shading: cache cell size in pixels of the centre view at the cell's depth, at
+    /// least; widened until a cell gathers 256 fill samples (`RenderJob::cache_params`).
     pub cache_cell: f64,
     /// Shared shading: glossy lobes at least this many times as wide as the camera grid's
     /// angle at a point are shared by all views (see `render::cache`).
@@ -210,7 +211,7 @@ pub struct RenderConfig {
 impl Default for RenderConfig {
     fn default() -> Self {
         Self {
-            spp: 16,
+            spp: 20,
             gt_spp: 0,
             max_depth: 5,
             rr_depth: 3,
@@ -225,7 +226,7 @@ impl Default for RenderConfig {
             exposure: 1.0,
             tone_curve: ToneCurve::Agx,
             shading: ShadingMode::Shared,
-            cache_spp: 4,
+            cache_spp: 1,
             cache_cell: 1.0,
             glossy_share: 4.0,
             texture_filter: true,
@@ -257,7 +258,7 @@ impl Config {
 /// Named bundles of overrides, applied before the user's `--set`s.
 pub const PRESETS: &[(&str, &[&str])] = &[
     ("full", &[]),
-    ("quick", &["camera.resolution=[128,128]", "render.spp=8"]),
+    ("quick", &["camera.resolution=[128,128]", "render.spp=10"]),
     ("wide", &["camera.disparity_range=[-40.0,40.0]"]),
 ];
 
@@ -483,7 +484,7 @@ mod tests {
         let cfg = Config::load(None, &["quick".into()], &sets).unwrap();
         assert_eq!(cfg.camera.resolution, [64, 48]);
         assert_eq!(cfg.render.gt_views, GtViews::All);
-        assert_eq!(cfg.render.spp, 8, "preset applied");
+        assert_eq!(cfg.render.spp, 10, "preset applied");
         let err = Config::load(None, &[], &["render.spp_=3".into()]).unwrap_err();
         assert!(format!("{err:#}").contains("render.spp_"), "{err:#}");
         let err = Config::load(None, &[], &["render=3".into()]).unwrap_err();

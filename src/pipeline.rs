@@ -1,13 +1,14 @@
 //! One scene from description to published folder: build, frame, render every view, write —
 //! for generated scenes, imported glTF scenes and saved `scene.json` files alike.
 
+use crate::camera::LightFieldCamera;
 use crate::config::{BaselineMode, Config, GtViews, ShadingMode, SliceAssignment};
 use crate::output::images::ToneCurve;
 use crate::output::scene_dir::{GtImages, SceneWriter};
 use crate::procgen::builtin;
 use crate::procgen::library::AssetLibrary;
 use crate::render::RenderScene;
-use crate::render::cache::CacheParams;
+use crate::render::cache::{CacheParams, RadianceCache};
 use crate::render::framing::auto_exposure;
 use crate::render::integrator::{PathSettings, Shading};
 use crate::render::view::{RenderSettings, ViewOutput, gt_own_spp};
@@ -21,6 +22,11 @@ use std::sync::atomic::AtomicU64;
 
 /// Fill samples a shared-shading cache cell gathers per colour sample of a pixel, at least.
 pub const FILL_PER_SPP: u32 = 1;
+
+/// Fill samples a shared-shading cache cell gathers at least: where the views' fill takes
+/// fewer per pixel footprint, cells grow until they hold this many (see
+/// [`RenderJob::cache_params`]).
+pub const CELL_FILL: f64 = 256.0;
 
 /// Rendering choices that are not part of the scene itself.
 #[derive(Clone, Debug)]
@@ -43,6 +49,7 @@ pub struct RenderJob {
     pub shading: ShadingMode,
     /// Fill samples per pixel of every view, at least (see [`RenderJob::fill_spp`]).
     pub cache_spp: u32,
+    /// The configured cache; its cell is the smallest allowed (see [`RenderJob::cache_params`]).
     pub cache: CacheParams,
     /// Filter library textures over a sample's footprint (see [`PathSettings::footprint`]).
     pub texture_filter: bool,
@@ -99,10 +106,43 @@ impl RenderJob {
     /// would put a floor under its noise however high `spp` goes (validate.sh, the centre
     /// view alone at 1024 spp: 4.98 % mean block difference against Mitsuba with 4 fill
     /// samples, 0.84 / 0.51 % with 114 / 1024, the independent estimator 0.31 %). At the
-    /// defaults (16 spp, 81 views) the floor of 4 per view is already 20 × spp per cell.
+    /// defaults (20 spp, 81 views) the floor of 1 per view already gives 4 × spp per pixel
+    /// footprint, and [`Self::cache_params`] more per cell.
     pub fn fill_spp(&self, views: u32) -> u32 {
         let per_view = (FILL_PER_SPP * self.spp).div_ceil(views.max(1));
         self.cache_spp.max(per_view)
+    }
+
+    /// The cache of a scene with `views` views: `render.cache_cell`, widened until a cell
+    /// gathers [`CELL_FILL`] fill samples (`fill_spp × views` per pixel footprint). A fill
+    /// sample costs about five camera samples (a full path against one cache lookup), so at
+    /// the defaults one per view and cells √(256 / 81) ≈ 1.8 pixel footprints wide are the
+    /// cheaper way to a quiet cache: on `lfgen bench --quality` (128², 3 Dec 2026) they gave
+    /// the views of 4 fill samples and 1-pixel cells within −0.5…+0.3 dB (8-bit), and a
+    /// full-size scene in 0.69× the time, with 20 spp for 16 (crates/lfrender/README.md). The
+    /// wider cell blurs the lighting over more of a pixel footprint; where the fill is dense
+    /// (validate.sh's single view at 1024 spp) the configured cell stays.
+    pub fn cache_params(&self, views: u32) -> CacheParams {
+        let per_footprint = self.fill_spp(views) as f64 * views.max(1) as f64;
+        let cell = (CELL_FILL / per_footprint).sqrt() as f32;
+        CacheParams {
+            cell_px: self.cache.cell_px.max(cell),
+            ..self.cache
+        }
+    }
+
+    /// Fills the shared-shading cache of `scene` seen by `cam` ([`Self::fill_spp`] samples per
+    /// pixel of every view, cells as [`Self::cache_params`] says).
+    pub fn fill_cache(
+        &self,
+        scene: &RenderScene,
+        cam: &LightFieldCamera,
+        settings: &RenderSettings,
+        samples_done: &AtomicU64,
+    ) -> RadianceCache {
+        let views = cam.num_views();
+        let (spp, params) = (self.fill_spp(views), self.cache_params(views));
+        scene.fill_cache(cam, settings, spp, params, samples_done)
     }
 
     /// Per-view render settings for scene `desc`.
@@ -171,15 +211,8 @@ pub fn render_scene(
     let mut order: Vec<u32> = vec![center];
     order.extend((0..desc.camera.num_views()).filter(|&v| v != center));
     let mut stats = None;
-    let cache = (job.shading == ShadingMode::Shared).then(|| {
-        scene.fill_cache(
-            &desc.camera,
-            &settings,
-            job.fill_spp(desc.camera.num_views()),
-            job.cache,
-            samples_done,
-        )
-    });
+    let cache = (job.shading == ShadingMode::Shared)
+        .then(|| job.fill_cache(scene, &desc.camera, &settings, samples_done));
     let shading = cache.as_ref().map_or(Shading::Independent, Shading::read);
     for view in order {
         let with_gt = view == center || per_view;
@@ -342,8 +375,25 @@ mod tests {
     }
 
     #[test]
+    fn cells_widen_until_they_hold_256_fill_samples() {
+        let cell = |spp, cache_spp, views| job(spp, cache_spp, 0).cache_params(views).cell_px;
+        // Defaults: 1 fill sample per view × 81 views per pixel footprint → √(256 / 81) px.
+        assert!((cell(20, 1, 81) - 16.0 / 9.0).abs() < 1e-6);
+        // 4 per view → 324 ≥ 256: the configured 1 px; validate.sh's single view at 1024 too.
+        assert_eq!(cell(16, 4, 81), 1.0);
+        assert_eq!(cell(1024, 1, 1), 1.0);
+        // A single view at 16 spp: 16 per footprint → 4 px.
+        assert!((cell(16, 1, 1) - 4.0).abs() < 1e-6);
+        // A configured cell wider than the rule wins.
+        let mut wide = job(20, 1, 0);
+        wide.cache.cell_px = 3.0;
+        assert_eq!(wide.cache_params(81).cell_px, 3.0);
+    }
+
+    #[test]
     fn the_fill_grows_with_spp_over_the_views() {
-        // Defaults: 16 spp over 81 views needs 1 per view; the floor of 4 stays.
+        // Defaults: 20 spp over 81 views needs 1 per view; so does the floor.
+        assert_eq!(job(20, 1, 0).fill_spp(81), 1);
         assert_eq!(job(16, 4, 0).fill_spp(81), 4);
         // 1024 spp over 3×3 views → ⌈1024 / 9⌉ = 114 per view; validate.sh's single view
         // takes all 1024 itself.
