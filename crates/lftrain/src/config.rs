@@ -307,6 +307,15 @@ pub struct EpiShiftConfig {
     pub refine_threshold: f32,
     /// Side of that median filter (odd; the thesis gives no size).
     pub median_window: usize,
+    /// Coarse-to-fine inference (not in the thesis; 0: off): a scene whose largest |disparity|
+    /// exceeds this many pixels is first solved on its views box-averaged by the smallest
+    /// power of two that brings it within, and at full size each pixel then chooses only among
+    /// the shifts within `coarse_radius` of that estimate. Why: at ±40 px an outer view moves
+    /// 160 px and occlusion bands are tens of pixels wide, far from anything a narrow training
+    /// set shows; scaled down, the scene looks like the training data again.
+    pub coarse_max: f32,
+    /// Shifts (pixels) around the scaled-up coarse estimate that the full-size pass may choose.
+    pub coarse_radius: f32,
     /// Disparity range the inference shifts cover; left out: each scene's
     /// `parameters.cfg` range (`disp_min`, `disp_max`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -327,6 +336,8 @@ impl Default for EpiShiftConfig {
             alpha: 2.5,
             refine_threshold: 0.01,
             median_window: 5,
+            coarse_max: 0.0,
+            coarse_radius: 2.0,
             range: None,
         }
     }
@@ -342,6 +353,18 @@ impl EpiShiftConfig {
     /// so `round(lo) ..= round(hi)`.
     pub fn shifts_for(lo: f32, hi: f32) -> Vec<i32> {
         (lo.round() as i32..=hi.round() as i32).collect()
+    }
+
+    /// The down-scaling of coarse-to-fine inference for a scene spanning `[lo, hi]`: the
+    /// smallest power of two `k` with `max(|lo|, |hi|) / k ≤ coarse_max`; 1 when that is
+    /// already met or coarse-to-fine is off.
+    pub fn coarse_scale(&self, [lo, hi]: [f32; 2]) -> usize {
+        let reach = lo.abs().max(hi.abs());
+        let mut k = 1;
+        while self.coarse_max > 0.0 && reach / k as f32 > self.coarse_max && k < 64 {
+            k *= 2;
+        }
+        k
     }
 
     /// The shifts of a training crop relative to its base shift: `-K ..= K`.
@@ -394,6 +417,10 @@ impl EpiShiftConfig {
             || self.median_window > 63
         {
             bail!("epishift.refine_threshold must lie in [0, 1], median_window be odd and ≤ 63");
+        }
+        let coarse_ok = self.coarse_max.is_finite() && self.coarse_max >= 0.0;
+        if !(coarse_ok && self.coarse_radius.is_finite() && self.coarse_radius >= 0.5) {
+            bail!("epishift.coarse_max must be finite and ≥ 0, coarse_radius finite and ≥ 0.5");
         }
         if let Some([lo, hi]) = self.range {
             if !(lo.is_finite() && hi.is_finite() && lo <= hi) {

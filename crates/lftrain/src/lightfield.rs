@@ -155,6 +155,52 @@ impl LightField {
     pub fn rotate(&self, quarter_turns: usize) -> Self {
         (0..quarter_turns % 4).fold(self.clone(), |lf, _| lf.rotate90())
     }
+
+    /// Down-scaled by `k`: each output pixel the mean of a `k × k` block (the last partial
+    /// row and column of blocks dropped), every disparity divided by `k`. A box average, not
+    /// [`crop`](Self::crop)'s slicing: a rendered view's noise then falls with the scale too.
+    pub fn downscale(&self, k: usize) -> Self {
+        let k = k.max(1);
+        let (w, h) = (self.width / k, self.height / k);
+        let views = self
+            .views
+            .iter()
+            .map(|view| {
+                view.as_ref()
+                    .map(|rgb| box_downscale(rgb, self.width, (w, h), k))
+            })
+            .collect();
+        Self {
+            n: self.n,
+            width: w,
+            height: h,
+            views,
+            disparity_range: self
+                .disparity_range
+                .map(|[lo, hi]| [lo / k as f32, hi / k as f32]),
+        }
+    }
+}
+
+/// The `w × h` image of `k × k` block means of an RGB image `stride` pixels wide.
+fn box_downscale(rgb: &[f32], stride: usize, (w, h): (usize, usize), k: usize) -> Vec<f32> {
+    let scale = 1.0 / (k * k) as f32;
+    let mut out = Vec::with_capacity(w * h * 3);
+    for y in 0..h {
+        for x in 0..w {
+            let mut sum = [0.0f32; 3];
+            for yy in y * k..(y + 1) * k {
+                for xx in x * k..(x + 1) * k {
+                    let i = (yy * stride + xx) * 3;
+                    sum.iter_mut()
+                        .zip(&rgb[i..i + 3])
+                        .for_each(|(s, v)| *s += v);
+                }
+            }
+            out.extend(sum.map(|s| s * scale));
+        }
+    }
+    out
 }
 
 /// The source `(x, y)` of target pixel `(x', y')` of the 90° rotation of a `w × h` grid:
@@ -217,6 +263,19 @@ mod tests {
             rotate_plane(&a, w, h, 1)
         });
         assert_eq!(four, img);
+    }
+
+    #[test]
+    fn downscale_averages_blocks_and_divides_the_range() {
+        // A 5 × 5 grid (view (1, 0) is off the star) of 5 × 3 views, red = x + 10 y: 2 × 1 blocks of 2 × 2 (the last column and row dropped).
+        let mut lf = LightField::from_fn(5, 5, 3, |_, _, x, y| [(x + 10 * y) as f32, 1.0, 0.0]);
+        lf.disparity_range = Some([-8.0, 4.0]);
+        let d = lf.downscale(2);
+        assert_eq!((d.width, d.height), (2, 1));
+        assert_eq!(d.disparity_range, Some([-4.0, 2.0]));
+        // Block means: (0 + 1 + 10 + 11) / 4 = 5.5, (2 + 3 + 12 + 13) / 4 = 7.5.
+        assert_eq!(d.view(2, 2), &[5.5, 1.0, 0.0, 7.5, 1.0, 0.0]);
+        assert!(d.views[0].is_some() && d.views[1].is_none());
     }
 
     #[test]

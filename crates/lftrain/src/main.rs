@@ -43,6 +43,11 @@ enum Command {
         /// parameters.cfg; ese: default its config's passes).
         #[arg(long, value_name = "MIN,MAX", allow_hyphen_values = true, value_parser = parse_range)]
         range: Option<[f32; 2]>,
+        /// EPI-Shift coarse to fine: scenes whose largest |disparity| exceeds PX are first
+        /// solved on views scaled down to bring it within PX (overrides the run's
+        /// epishift.coarse_max; 0: off).
+        #[arg(long, value_name = "PX")]
+        coarse_max: Option<f32>,
     },
     /// Seconds per training step of a configuration on random input (no data loading), or
     /// with --loader the crops/s of the data loader alone.
@@ -204,8 +209,9 @@ fn run(cli: Cli) -> Result<()> {
             dataset,
             out,
             range,
+            coarse_max,
         } => {
-            let n = predict_dataset_over(&run, &dataset, &out, cli.quiet, range)?;
+            let n = predict_dataset_over(&run, &dataset, &out, cli.quiet, range, coarse_max)?;
             eprintln!("lftrain: {n} scenes written to {}", out.display());
         }
     }

@@ -14,7 +14,7 @@ use crate::config::{ModelKind, TrainConfig};
 use crate::epishift::EpiShiftNet;
 use crate::lightfield::LightField;
 use crate::model::{EpiNet, Network};
-use crate::shift_predict::{decide, run_shifts, scene_shifts};
+use crate::shift_predict::estimate;
 use crate::stacks::{Direction, Region, extract};
 use crate::tensors::{tensor4, values};
 
@@ -56,9 +56,7 @@ pub fn predict_epishift(
     device: &Device,
 ) -> ScenePrediction {
     let start = Instant::now();
-    let shifts = scene_shifts(&cfg.epishift, lf);
-    let maps = run_shifts(net, lf, &shifts, cfg.epishift.unet_depth, device);
-    let est = decide(&maps, &cfg.epishift);
+    let est = estimate(net, lf, &cfg.epishift, device);
     let (w, h) = (lf.width, lf.height);
     let uncertainty = est.confidence.iter().map(|c| 1.0 - c).collect();
     ScenePrediction {
@@ -163,7 +161,7 @@ pub fn predict_dataset(
     out: &std::path::Path,
     quiet: bool,
 ) -> anyhow::Result<usize> {
-    predict_dataset_over(run, dataset, out, quiet, None)
+    predict_dataset_over(run, dataset, out, quiet, None, None)
 }
 
 /// [`predict_dataset`] with the disparity range of the shifts given (`--range`): EPI-Shift's
@@ -175,9 +173,21 @@ pub fn predict_dataset_over(
     out: &std::path::Path,
     quiet: bool,
     range: Option<[f32; 2]>,
+    coarse_max: Option<f32>,
 ) -> anyhow::Result<usize> {
     let run = crate::run::RunDir::new(run);
     let mut cfg = run.config()?;
+    if let Some(c) = coarse_max {
+        if cfg.model != ModelKind::EpiShift {
+            anyhow::bail!(
+                "--coarse-max applies to epishift runs, this is {}",
+                cfg.model.name()
+            );
+        }
+        cfg.epishift.coarse_max = c;
+        cfg.validate()
+            .map_err(|e| e.context(format!("--coarse-max {c}")))?;
+    }
     if let Some(r) = range {
         match cfg.model {
             ModelKind::EpiShift => cfg.epishift.range = Some(r),

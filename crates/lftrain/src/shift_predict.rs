@@ -1,6 +1,7 @@
 //! EPI-Shift inference (thesis §4.2, §4.2.6): the network at every integer shift that covers
 //! the scene's disparity range, `D = s* + R^{s*}` with `s* = argmax_s C^s`, and the refinement
-//! of eq. 4.11 where no classification is confident.
+//! of eq. 4.11 where no classification is confident; optionally coarse to fine
+//! (`epishift.coarse_max`), which the thesis does not do.
 
 use std::collections::VecDeque;
 
@@ -22,6 +23,58 @@ pub fn scene_shifts(cfg: &EpiShiftConfig, lf: &LightField) -> Vec<i32> {
     let mut shifts = EpiShiftConfig::shifts_for(lo, hi);
     shifts.truncate(MAX_SHIFTS);
     shifts
+}
+
+/// The estimate of `net` for `lf`: one pass over the shifts covering its range or, where
+/// `cfg.coarse_max` asks for it, first a pass on the views down-scaled by
+/// [`EpiShiftConfig::coarse_scale`] whose estimate, scaled back up, limits each pixel's
+/// choice at full size to the shifts within `cfg.coarse_radius` of it.
+pub fn estimate(
+    net: &EpiShiftNet,
+    lf: &LightField,
+    cfg: &EpiShiftConfig,
+    device: &Device,
+) -> ShiftEstimate {
+    let range = cfg.range.or(lf.disparity_range).unwrap_or(FALLBACK_RANGE);
+    let k = cfg.coarse_scale(range);
+    let mut shifts = scene_shifts(cfg, lf);
+    let prior = (k > 1).then(|| {
+        let small = lf.downscale(k);
+        let kf = k as f32;
+        let coarse = EpiShiftConfig {
+            coarse_max: 0.0,
+            range: Some([range[0] / kf, range[1] / kf]),
+            ..cfg.clone()
+        };
+        let est = estimate(net, &small, &coarse, device);
+        upsample(
+            &est.disparity,
+            (small.width, small.height),
+            k,
+            (lf.width, lf.height),
+        )
+    });
+    if let Some(p) = &prior {
+        // Only the shifts some pixel may still choose.
+        let (lo, hi) = p
+            .iter()
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &d| {
+                (a.min(d), b.max(d))
+            });
+        shifts
+            .retain(|&s| s as f32 >= lo - cfg.coarse_radius && s as f32 <= hi + cfg.coarse_radius);
+    }
+    let maps = run_shifts(net, lf, &shifts, cfg.unet_depth, device);
+    decide(&maps, cfg, prior.as_deref())
+}
+
+/// A `w × h` disparity map scaled up by `k` to `out` (nearest neighbour, the values × `k`;
+/// pixels beyond the last whole block take the edge block's value).
+fn upsample(d: &[f32], (w, h): (usize, usize), k: usize, (ow, oh): (usize, usize)) -> Vec<f32> {
+    (0..oh)
+        .flat_map(|y| (0..ow).map(move |x| (x, y)))
+        .map(|(x, y)| d[(y / k).min(h - 1) * w + (x / k).min(w - 1)] * k as f32)
+        .collect()
 }
 
 /// `C^s` and `R^s` of every shift, planes of `width × height`.
@@ -116,19 +169,32 @@ pub struct ShiftEstimate {
 
 /// `D = s* + R^{s*}`; where `max_s C^s < cfg.refine_threshold` (eq. 4.11), `s*` is taken on
 /// the median-filtered `C^s` (a `median_window²` window, clipped to the image) instead.
-pub fn decide(maps: &ShiftMaps, cfg: &EpiShiftConfig) -> ShiftEstimate {
+/// With a `prior` (a disparity per pixel), pixel `i` chooses only among the shifts within
+/// `cfg.coarse_radius` of `prior[i]` clamped to the shifts' range, so at least one remains.
+pub fn decide(maps: &ShiftMaps, cfg: &EpiShiftConfig, prior: Option<&[f32]>) -> ShiftEstimate {
     let (w, h) = (maps.width, maps.height);
     let mut est = ShiftEstimate {
         disparity: Vec::with_capacity(w * h),
         confidence: Vec::with_capacity(w * h),
         refined: 0,
     };
+    let (first, last) = (
+        maps.shifts[0] as f32,
+        maps.shifts[maps.shifts.len() - 1] as f32,
+    );
     for i in 0..w * h {
-        let (mut best, conf) = argmax(maps.class.iter().map(|c| c[i]));
+        let allowed = |k: usize| {
+            prior.is_none_or(|p| {
+                (maps.shifts[k] as f32 - p[i].clamp(first, last)).abs() <= cfg.coarse_radius
+            })
+        };
+        let masked = |k: usize, v: f32| if allowed(k) { v } else { f32::NEG_INFINITY };
+        let (mut best, conf) = argmax(maps.class.iter().enumerate().map(|(k, c)| masked(k, c[i])));
         est.confidence.push(conf);
         if conf < cfg.refine_threshold {
             let r = cfg.median_window / 2;
-            best = argmax(maps.class.iter().map(|c| median(c, w, h, i, r))).0;
+            let filtered = maps.class.iter().enumerate();
+            best = argmax(filtered.map(|(k, c)| masked(k, median(c, w, h, i, r)))).0;
             est.refined += 1;
         }
         est.disparity
@@ -181,7 +247,7 @@ mod tests {
             2,
             1,
         );
-        let e = decide(&m, &EpiShiftConfig::default());
+        let e = decide(&m, &EpiShiftConfig::default(), None);
         let want = [1.3, -1.2];
         assert!(
             e.disparity
@@ -208,14 +274,54 @@ mod tests {
             median_window: 3,
             ..EpiShiftConfig::default()
         };
-        let e = decide(&m, &cfg);
+        let e = decide(&m, &cfg, None);
         assert_eq!(e.refined, 1);
         assert_eq!(e.disparity[4], 0.25);
         let off = EpiShiftConfig {
             refine_threshold: 0.0,
             ..cfg
         };
-        assert_eq!(decide(&m, &off).disparity[4], -0.9);
+        assert_eq!(decide(&m, &off, None).disparity[4], -0.9);
+    }
+
+    #[test]
+    fn a_prior_limits_the_choice_to_nearby_shifts() {
+        // Shifts -1..=3 at one pixel; shift 3 has the largest C, but the prior 0.4 with
+        // radius 1.5 allows only -1, 0 and 1, of which 1 is the largest (offset 0.2).
+        let m = maps(
+            vec![vec![0.1], vec![0.2], vec![0.5], vec![0.0], vec![0.9]],
+            vec![vec![0.0], vec![0.0], vec![0.2], vec![0.0], vec![-0.1]],
+            1,
+            1,
+        );
+        let cfg = EpiShiftConfig {
+            coarse_radius: 1.5,
+            ..EpiShiftConfig::default()
+        };
+        assert_eq!(decide(&m, &cfg, None).disparity, vec![2.9]);
+        let e = decide(&m, &cfg, Some(&[0.4]));
+        assert_eq!((e.disparity[0], e.confidence[0]), (1.2, 0.5));
+        // A prior beyond the shifts is clamped to the last one: 3 (and 2) stay allowed.
+        assert_eq!(decide(&m, &cfg, Some(&[40.0])).disparity, vec![2.9]);
+    }
+
+    #[test]
+    fn coarse_scale_brings_the_range_within_coarse_max() {
+        let mut cfg = EpiShiftConfig::default();
+        assert_eq!(cfg.coarse_scale([-40.0, 40.0]), 1, "off by default");
+        cfg.coarse_max = 12.0;
+        assert_eq!(cfg.coarse_scale([-3.5, 3.5]), 1);
+        assert_eq!(cfg.coarse_scale([-12.0, 5.0]), 1);
+        assert_eq!(cfg.coarse_scale([-39.7, 33.8]), 4);
+        assert_eq!(cfg.coarse_scale([0.0, 24.5]), 4);
+        assert_eq!(cfg.coarse_scale([0.0, 24.0]), 2);
+    }
+
+    #[test]
+    fn upsampling_repeats_blocks_and_scales_values() {
+        // 2 × 1 → 5 × 2 at k = 2: the fifth column takes the last block.
+        let up = upsample(&[1.0, -0.5], (2, 1), 2, (5, 2));
+        assert_eq!(up, [2.0, 2.0, -1.0, -1.0, -1.0].repeat(2));
     }
 
     #[test]
