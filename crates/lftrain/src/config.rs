@@ -356,8 +356,8 @@ impl EpiShiftConfig {
     }
 
     /// The down-scaling of coarse-to-fine inference for a scene spanning `[lo, hi]`: the
-    /// smallest power of two `k` with `max(|lo|, |hi|) / k ≤ coarse_max`; 1 when that is
-    /// already met or coarse-to-fine is off.
+    /// smallest power of two `k` (at most 64) with `max(|lo|, |hi|) / k ≤ coarse_max`; 1 when
+    /// that is already met or coarse-to-fine is off.
     pub fn coarse_scale(&self, [lo, hi]: [f32; 2]) -> usize {
         let reach = lo.abs().max(hi.abs());
         let mut k = 1;

@@ -267,7 +267,8 @@ mod tests {
 
     #[test]
     fn downscale_averages_blocks_and_divides_the_range() {
-        // A 5 × 5 grid (view (1, 0) is off the star) of 5 × 3 views, red = x + 10 y: 2 × 1 blocks of 2 × 2 (the last column and row dropped).
+        // A 5 × 5 grid (view (1, 0) is off the star) of 5 × 3 views, red = x + 10 y:
+        // 2 × 1 blocks of 2 × 2 (the last column and row dropped).
         let mut lf = LightField::from_fn(5, 5, 3, |_, _, x, y| [(x + 10 * y) as f32, 1.0, 0.0]);
         lf.disparity_range = Some([-8.0, 4.0]);
         let d = lf.downscale(2);

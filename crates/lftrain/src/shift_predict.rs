@@ -193,8 +193,15 @@ pub fn decide(maps: &ShiftMaps, cfg: &EpiShiftConfig, prior: Option<&[f32]>) -> 
         est.confidence.push(conf);
         if conf < cfg.refine_threshold {
             let r = cfg.median_window / 2;
-            let filtered = maps.class.iter().enumerate();
-            best = argmax(filtered.map(|(k, c)| masked(k, median(c, w, h, i, r)))).0;
+            // The median (a sort) only at the shifts this pixel may choose.
+            let filtered = maps.class.iter().enumerate().map(|(k, c)| {
+                if allowed(k) {
+                    median(c, w, h, i, r)
+                } else {
+                    f32::NEG_INFINITY
+                }
+            });
+            best = argmax(filtered).0;
             est.refined += 1;
         }
         est.disparity
