@@ -7,7 +7,7 @@ use crate::pipeline::{RenderJob, generate_scene};
 use crate::render::framing::auto_exposure;
 use crate::render::integrator::Shading;
 use crate::render::sampler::RayKey;
-use crate::render::view::RenderSettings;
+use crate::render::view::{Adaptive, RenderSettings};
 use anyhow::{Context, Result};
 use glam::Vec3;
 use rayon::prelude::*;
@@ -149,7 +149,7 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
     println!(
         "scene | shading | PSNR linear dB: vs reference (vs truth) | PSNR 8-bit dB: vs reference \
          (vs truth) | photo residual (8-bit levels) | s per scene | per-view noise share: \
-         linear / 8-bit"
+         linear / 8-bit | pixels given adaptive samples"
     );
     for &index in scenes {
         let (desc, scene) = generate_scene(&cfg, index, None)?;
@@ -162,6 +162,7 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
             spp,
             gt_spp: spp,
             seed: desc.seed ^ salt,
+            adaptive: Adaptive::default(),
             ..job.settings(&desc)
         };
         let [a, b] = [REFERENCE_SALT, REFERENCE_SALT + 1].map(|salt| {
@@ -233,7 +234,9 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
         );
         for shading in [ShadingMode::Shared, ShadingMode::Independent] {
             job.shading = shading;
-            let settings = job.settings(&desc);
+            let mut settings = job.settings(&desc);
+            // As in a dataset: adaptive sampling's noise in the final exposure's display units.
+            settings.adaptive.display_scale = exposure;
             let started = Instant::now();
             let cache = (shading == ShadingMode::Shared)
                 .then(|| job.fill_cache(&scene, cam, &settings, &counter));
@@ -250,10 +253,13 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
                     mode,
                     &counter,
                 );
-                (out.image.pixels, t.elapsed().as_secs_f64())
+                (out.image, t.elapsed().as_secs_f64())
             };
             let (c, t_view) = render(&settings, center);
+            let refined = 100.0 * c.refined as f64 / c.pixels.len() as f64;
+            let c = c.pixels;
             let (adjacent, _) = render(&settings, center + 1);
+            let adjacent = adjacent.pixels;
             let scene_s = fill + t_view * cam.num_views() as f64;
             write(&format!("{shading:?}").to_lowercase(), &c)?;
             let to_reference = mse(&c, &reference);
@@ -262,6 +268,7 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
             // differ only by the noise that is the view's own.
             let seed = settings.seed ^ PER_VIEW_SALT;
             let (again, _) = render(&RenderSettings { seed, ..settings }, center);
+            let again = again.pixels;
             write(&format!("{shading:?}_again").to_lowercase(), &again)?;
             let between = mse(&c, &again);
             let share = |k: usize| {
@@ -269,7 +276,8 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
                 100.0 * per_view_share(between[k], to_truth)
             };
             println!(
-                "{index} | {shading:?} | {linear} | {eight_bit} | {:.2} | {scene_s:.1} | {:.0} % / {:.0} %",
+                "{index} | {shading:?} | {linear} | {eight_bit} | {:.2} | {scene_s:.1} | {:.0} % / {:.0} % \
+                 | {refined:.1} %",
                 photo_residual(&c, &adjacent, &disparity, &gt.modes, [w, h], exposure, tone),
                 share(0),
                 share(1),

@@ -164,6 +164,13 @@ pub enum ShadingMode {
 pub struct RenderConfig {
     /// Samples per pixel (stratified over the pixel, box filter).
     pub spp: u32,
+    /// Adaptive sampling: extra samples for a pixel still noisy after `spp` (0: off; see
+    /// `render::view::Adaptive`).
+    pub adaptive_spp: u32,
+    /// Adaptive sampling: the noise above which a pixel gets `adaptive_spp` more samples —
+    /// the standard error of its mean over the square root of its brightness, summed over
+    /// RGB, in display units (Cycles' measure).
+    pub adaptive_threshold: f64,
     /// Camera samples per pixel of the ground truth (modes, η, MPI colours); 0 (default): the
     /// colour's own samples, at no extra tracing. More samples make η at edges and behind
     /// semi-transparent surfaces finer than the colour's spp allows.
@@ -211,7 +218,9 @@ pub struct RenderConfig {
 impl Default for RenderConfig {
     fn default() -> Self {
         Self {
-            spp: 20,
+            spp: 16,
+            adaptive_spp: 48,
+            adaptive_threshold: 0.15,
             gt_spp: 0,
             max_depth: 5,
             rr_depth: 3,
@@ -258,7 +267,14 @@ impl Config {
 /// Named bundles of overrides, applied before the user's `--set`s.
 pub const PRESETS: &[(&str, &[&str])] = &[
     ("full", &[]),
-    ("quick", &["camera.resolution=[128,128]", "render.spp=10"]),
+    (
+        "quick",
+        &[
+            "camera.resolution=[128,128]",
+            "render.spp=10",
+            "render.adaptive_spp=30",
+        ],
+    ),
     ("wide", &["camera.disparity_range=[-40.0,40.0]"]),
 ];
 
@@ -395,6 +411,14 @@ impl Config {
         if !(0.0..1.0).contains(&r.mode_epsilon) || !r.exposure.is_finite() || r.exposure <= 0.0 {
             bail!("render.mode_epsilon must be in [0, 1) and render.exposure positive");
         }
+        if r.adaptive_spp > MAX_SPP || r.adaptive_threshold.is_nan() || r.adaptive_threshold < 0.0 {
+            bail!(
+                "render.adaptive_spp must be ≤ {MAX_SPP} and render.adaptive_threshold a number ≥ 0: \
+                 {}, {}",
+                r.adaptive_spp,
+                r.adaptive_threshold
+            );
+        }
         self.scene.validate()?;
         self.gltf.validate()
     }
@@ -487,6 +511,13 @@ mod tests {
         assert_eq!(cfg.render.spp, 10, "preset applied");
         let err = Config::load(None, &[], &["render.spp_=3".into()]).unwrap_err();
         assert!(format!("{err:#}").contains("render.spp_"), "{err:#}");
+        for bad in [
+            "render.adaptive_threshold=-1",
+            "render.adaptive_threshold=nan",
+        ] {
+            let err = Config::load(None, &[], &[bad.into()]).unwrap_err();
+            assert!(format!("{err:#}").contains("adaptive_threshold"), "{err:#}");
+        }
         let err = Config::load(None, &[], &["render=3".into()]).unwrap_err();
         assert!(format!("{err:#}").contains("section"), "{err:#}");
     }

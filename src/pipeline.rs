@@ -11,7 +11,7 @@ use crate::render::RenderScene;
 use crate::render::cache::{CacheParams, RadianceCache};
 use crate::render::framing::auto_exposure;
 use crate::render::integrator::{PathSettings, Shading};
-use crate::render::view::{RenderSettings, ViewOutput, gt_own_spp};
+use crate::render::view::{Adaptive, RenderSettings, ViewOutput, gt_own_spp};
 use crate::scene::SceneDesc;
 use crate::scene::assets::Assets;
 use crate::stats::SceneStats;
@@ -32,6 +32,9 @@ pub const CELL_FILL: f64 = 256.0;
 #[derive(Clone, Debug)]
 pub struct RenderJob {
     pub spp: u32,
+    /// Extra samples of noisy pixels and the noise that calls for them ([`Adaptive`]).
+    pub adaptive_spp: u32,
+    pub adaptive_threshold: f32,
     /// Camera samples per pixel of the ground truth (`spp` unless configured).
     pub gt_spp: u32,
     pub path: PathSettings,
@@ -60,6 +63,8 @@ impl RenderJob {
         let r = &cfg.render;
         Self {
             spp: r.spp,
+            adaptive_spp: r.adaptive_spp,
+            adaptive_threshold: r.adaptive_threshold as f32,
             gt_spp: if r.gt_spp == 0 { r.spp } else { r.gt_spp },
             path: PathSettings {
                 max_depth: r.max_depth,
@@ -164,6 +169,11 @@ impl RenderJob {
             mode_epsilon: self.mode_epsilon,
             shade_all_hits: self.shade_all_hits,
             slice_assignment: self.slice_assignment,
+            adaptive: Adaptive {
+                extra: self.adaptive_spp,
+                threshold: self.adaptive_threshold,
+                display_scale: desc.exposure,
+            },
         }
     }
 }
@@ -204,7 +214,6 @@ pub fn render_scene(
     samples_done: &AtomicU64,
 ) -> Result<Vec<FileEntry>> {
     let writer = SceneWriter::create(final_dir, job.write_exr, job.tone_curve)?;
-    let settings = job.settings(desc);
     let center = desc.camera.center_view();
     let per_view = job.gt_views == GtViews::All;
     // The centre view first: it fixes the exposure for all views and carries the GT.
@@ -212,8 +221,24 @@ pub fn render_scene(
     order.extend((0..desc.camera.num_views()).filter(|&v| v != center));
     let mut stats = None;
     let cache = (job.shading == ShadingMode::Shared)
-        .then(|| job.fill_cache(scene, &desc.camera, &settings, samples_done));
+        .then(|| job.fill_cache(scene, &desc.camera, &job.settings(desc), samples_done));
     let shading = cache.as_ref().map_or(Shading::Independent, Shading::read);
+    // Adaptive sampling judges noise in display units, so with it the exposure comes first,
+    // from the centre view without the extra samples — the image a render without adaptive
+    // sampling makes, GT pass included (its first hits come from the all-hits trace), so the
+    // exposure is the same either way; about 1/60 of a 9×9 scene's time. Without it, from the
+    // centre view itself.
+    let adaptive = job.adaptive_spp > 0;
+    if job.auto_exposure && adaptive {
+        let plain = RenderSettings {
+            adaptive: Adaptive::default(),
+            ..job.settings(desc)
+        };
+        let (cam, slices) = (&desc.camera, &desc.slices);
+        let out = scene.render_view_with(cam, slices, &plain, center, true, shading, samples_done);
+        desc.exposure *= auto_exposure(&out.image.pixels);
+    }
+    let settings = job.settings(desc);
     for view in order {
         let with_gt = view == center || per_view;
         let out = scene.render_view_with(
@@ -225,7 +250,7 @@ pub fn render_scene(
             shading,
             samples_done,
         );
-        if view == center && job.auto_exposure {
+        if view == center && job.auto_exposure && !adaptive {
             desc.exposure *= auto_exposure(&out.image.pixels);
         }
         writer.write_view(

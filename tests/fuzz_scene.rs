@@ -13,7 +13,7 @@ use lfgen::config::Config;
 use lfgen::render::RenderScene;
 use lfgen::render::integrator::PathSettings;
 use lfgen::render::slices::SliceAssignment;
-use lfgen::render::view::RenderSettings;
+use lfgen::render::view::{Adaptive, RenderSettings};
 use lfgen::scene::SceneDesc;
 use lfgen::scene::assets::Assets;
 use mutate::{can_bound, mutate, run_bounded};
@@ -79,6 +79,7 @@ fn run_in_process(v: Value) -> Outcome {
         mode_epsilon: 0.01,
         shade_all_hits: false,
         slice_assignment: SliceAssignment::Surface,
+        adaptive: Adaptive::default(),
     };
     let center = desc.camera.center_view();
     let out = scene.render_view(

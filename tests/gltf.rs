@@ -12,7 +12,7 @@ use lfgen::config::{BaselineMode, Config, SliceSpacing};
 use lfgen::render::RenderScene;
 use lfgen::render::integrator::PathSettings;
 use lfgen::render::slices::SliceAssignment;
-use lfgen::render::view::{RenderSettings, ViewGt, ViewOutput};
+use lfgen::render::view::{Adaptive, RenderSettings, ViewGt, ViewOutput};
 use lfgen::scene::gltf::import;
 use lfgen::scene::{Light, SceneDesc, SliceRange, SurfaceModel};
 use std::fs;
@@ -85,6 +85,7 @@ impl Loaded {
             mode_epsilon: 1e-4,
             shade_all_hits: false,
             slice_assignment: SliceAssignment::Surface,
+            adaptive: Adaptive::default(),
         };
         let cam = &self.desc.camera;
         let view = cam.center_view();

@@ -8,6 +8,7 @@ mod common;
 use common::{Harness, Part, camera, disparity, emitter, f_px, matte, quad, scene, settings};
 use glam::{DVec3, Quat, Vec3};
 use lfgen::output::images::to_srgb8;
+use lfgen::render::view::{Adaptive, RenderSettings};
 use lfgen::scene::{Material, SceneDesc, SurfaceModel, Texture, Transform};
 
 const EYE: DVec3 = DVec3::new(0.0, 1.0, 4.0);
@@ -289,4 +290,75 @@ fn a_veil_over_a_light_is_composited_exactly() {
         .map(|c| (*c - Vec3::splat(7.0)).abs().max_element())
         .fold(0.0, f32::max);
     assert!(worst > 0.1, "stochastic transparency should show: {worst}");
+}
+
+/// Adaptive sampling spends its extra samples where a view is still noisy: on a glossy plane
+/// under a small light (its highlight is traced per view) the pixels it refines were far
+/// noisier than those it left alone, the view ends closer to the converged render, and an
+/// unreachable threshold changes nothing.
+#[test]
+fn adaptive_sampling_refines_the_noisy_pixels() {
+    let h = glossy_scene(0.3, 0.0);
+    let cache = h.cache(&settings(16, 5), 16);
+    let view = 12;
+    let render = |s: &RenderSettings| h.render_shared(view, s, &cache, false).image;
+    // Converged from its own seed and the same cache: what remains between it and a render
+    // is that render's per-view noise, the part adaptive sampling acts on.
+    let reference = render(&RenderSettings {
+        seed: 99,
+        ..settings(1024, 5)
+    })
+    .pixels;
+    let base = settings(8, 5);
+    let with = |threshold| RenderSettings {
+        adaptive: Adaptive {
+            extra: 24,
+            threshold,
+            display_scale: 1.0,
+        },
+        ..base
+    };
+    let plain = render(&base);
+    let off = render(&with(f32::INFINITY));
+    assert_eq!((off.pixels == plain.pixels, off.refined), (true, 0));
+    let sq = |a: &Vec3, b: &Vec3| (*a - *b).length_squared() as f64;
+    let adaptive = render(&with(0.1));
+    // Per-pixel squared error of the plain render, summed over the pixels adaptive sampling
+    // refined (those whose value changed) and over the rest.
+    let (mut refined, mut kept) = ((0.0, 0), (0.0, 0));
+    for ((p, a), r) in plain.pixels.iter().zip(&adaptive.pixels).zip(&reference) {
+        let group = if p == a { &mut kept } else { &mut refined };
+        *group = (group.0 + sq(p, r), group.1 + 1);
+    }
+    let n = plain.pixels.len();
+    let mse = |img: &[Vec3]| {
+        img.iter()
+            .zip(&reference)
+            .map(|(a, r)| sq(a, r))
+            .sum::<f64>()
+    };
+    let (before, after) = (
+        mse(&plain.pixels) / n as f64,
+        mse(&adaptive.pixels) / n as f64,
+    );
+    let (noisy, quiet) = (refined.0 / refined.1 as f64, kept.0 / kept.1 as f64);
+    eprintln!(
+        "refined {} of {n}; their error {noisy:.2e} vs the rest {quiet:.2e}; \
+         MSE {before:.2e} → {after:.2e}",
+        adaptive.refined
+    );
+    assert_eq!(
+        adaptive.refined, refined.1,
+        "the count is the pixels that changed"
+    );
+    assert!(
+        refined.1 > 0 && refined.1 < n / 4,
+        "{} of {n} refined",
+        refined.1
+    );
+    assert!(
+        noisy > 10.0 * quiet,
+        "refined {noisy:.2e} vs kept {quiet:.2e}"
+    );
+    assert!(after < 0.5 * before, "MSE {before:.2e} → {after:.2e}");
 }

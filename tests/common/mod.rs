@@ -11,7 +11,7 @@ use lfgen::render::RenderScene;
 use lfgen::render::cache::{CacheParams, RadianceCache};
 use lfgen::render::integrator::{PathSettings, Shading};
 use lfgen::render::slices::SliceAssignment;
-use lfgen::render::view::{RenderSettings, ViewOutput};
+use lfgen::render::view::{Adaptive, RenderSettings, ViewOutput};
 use lfgen::scene::{
     Material, Object, Opacity, SceneDesc, Shape, SliceRange, SurfaceModel, Texture, Transform,
 };
@@ -162,6 +162,7 @@ pub fn settings(spp: u32, max_depth: u32) -> RenderSettings {
         mode_epsilon: 1e-4,
         shade_all_hits: false,
         slice_assignment: SliceAssignment::Surface,
+        adaptive: Adaptive::default(),
     }
 }
 

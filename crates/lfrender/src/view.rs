@@ -30,6 +30,64 @@ pub struct RenderSettings {
     /// colour goes to the slice of the surface it saw).
     pub shade_all_hits: bool,
     pub slice_assignment: SliceAssignment,
+    pub adaptive: Adaptive,
+}
+
+/// Adaptive sampling: a pixel whose estimate is still noisy after its `spp` samples gets
+/// `extra` more, from a stream of their own.
+///
+/// Why: a view's own noise (what shared shading cannot share: the pixel-area integral over
+/// edges and fine texture, glass, mirrors and narrow glossy lobes) sits in few pixels — at
+/// 128² the noisiest 5 % hold about 80 % of it (`lfgen bench --quality`) — so spending samples
+/// there buys more PSNR than raising `spp` everywhere. The test is Cycles' adaptive-sampling
+/// error, the standard error of the pixel mean summed over RGB divided by the square root of
+/// its summed brightness (a rough perceptual weight), in display units.
+///
+/// Bias: the test looks at the samples it then averages, so pixels that drew a rare bright path
+/// get it diluted while pixels that missed it keep their dark estimate: the result leans dark
+/// where light arrives by rare paths, by at most the share `extra / (spp + extra)` of the
+/// selected pixels' first-pass excess. It vanishes as the threshold goes to zero (every pixel
+/// gets `spp + extra` samples) and is measured against the converged independent render in
+/// crates/lfrender/README.md.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Adaptive {
+    /// Extra camera samples of a noisy pixel (0: off).
+    pub extra: u32,
+    /// Largest accepted error (see above).
+    pub threshold: f32,
+    /// Radiance × `display_scale` = display units (1: white); the scene's exposure.
+    pub display_scale: f32,
+}
+
+impl Adaptive {
+    /// Whether the pixel whose `n` samples have these moments needs the extra samples.
+    fn wants_more(&self, m: &Moments, n: u32) -> bool {
+        if self.extra == 0 || n < 2 {
+            return false;
+        }
+        let n_f = n as f32;
+        let mean = m.sum / n_f;
+        // Unbiased sample variance, then the variance of the mean; in display units.
+        let var = ((m.squares / n_f - mean * mean) * (n_f / (n_f - 1.0))).max(Vec3::ZERO);
+        let k = self.display_scale;
+        let std_error = (var / n_f).map(f32::sqrt) * k;
+        let brightness = (mean * k).element_sum().max(0.0);
+        std_error.element_sum() / (1e-4 + brightness.sqrt()) > self.threshold
+    }
+}
+
+/// Sum and sum of squares (per channel) of a pixel's sample radiance.
+#[derive(Clone, Copy, Default)]
+struct Moments {
+    sum: Vec3,
+    squares: Vec3,
+}
+
+impl Moments {
+    fn add(&mut self, radiance: Vec3) {
+        self.sum += radiance;
+        self.squares += radiance * radiance;
+    }
 }
 
 impl RenderSettings {
@@ -55,6 +113,8 @@ pub struct ViewImage {
     pub width: usize,
     pub height: usize,
     pub pixels: Vec<Vec3>,
+    /// Pixels that adaptive sampling gave extra samples ([`Adaptive`]).
+    pub refined: usize,
 }
 
 /// Ground truth of one view.
@@ -104,6 +164,8 @@ struct Band {
     mode_counts: Vec<u32>,
     colors: Vec<[f32; 3]>,
     hci_depth: Vec<f32>,
+    /// Pixels that got adaptive sampling's extra samples.
+    refined: usize,
 }
 
 /// Salt of the fill pass's sample streams, so they are not the render's own.
@@ -117,6 +179,9 @@ const PATH_STREAM: u64 = 0xA7B5_7EA3;
 
 /// Salt of the ground truth's own camera and path streams when `gt_spp` differs from `spp`.
 const GT_STREAM: u64 = 0x6700_57EA;
+
+/// Salt of the camera and path streams of adaptive sampling's extra samples.
+const ADAPTIVE_STREAM: u64 = 0xADA9_7100;
 
 impl RenderScene {
     /// Renders `view` with the independent estimator; `samples_done` counts camera samples
@@ -262,8 +327,9 @@ fn grid_position(cam: &LightFieldCamera, view: u32) -> Vec2 {
 fn assemble(width: usize, height: usize, bands: Vec<Band>, with_gt: bool) -> ViewOutput {
     let mut pixels = Vec::with_capacity(width * height);
     let mut modes = ModeMap::new(width, height);
-    let (mut colors, mut hci_depth) = (Vec::new(), Vec::new());
+    let (mut colors, mut hci_depth, mut refined) = (Vec::new(), Vec::new(), 0);
     for band in bands {
+        refined += band.refined;
         pixels.extend(band.pixels);
         let mut start = 0;
         for n in band.mode_counts {
@@ -283,6 +349,7 @@ fn assemble(width: usize, height: usize, bands: Vec<Band>, with_gt: bool) -> Vie
             width,
             height,
             pixels,
+            refined,
         },
         gt,
     }
@@ -320,11 +387,20 @@ impl PixelCtx<'_> {
         // A GT view takes its colour's first hits from the all-hits trace either way, so its
         // image does not depend on `gt_spp` (the closest-hit query can pick the other one of
         // two coincident faces).
-        let sum = self.samples(s.scene_index, s.spp, with_gt, gt_inline, scratch);
+        let first = self.samples(s.scene_index, s.spp, with_gt, gt_inline, scratch);
+        let (mut sum, mut n) = (first.sum, s.spp);
+        if s.adaptive.wants_more(&first, s.spp) {
+            band.refined += 1;
+            // Colour only: the GT keeps its own fixed count, so η does not depend on noise.
+            let extra = s.adaptive.extra;
+            let stream = s.scene_index ^ ADAPTIVE_STREAM;
+            sum += self.samples(stream, extra, with_gt, false, scratch).sum;
+            n += extra;
+        }
         if with_gt && !gt_inline {
             self.samples(s.scene_index ^ GT_STREAM, s.gt_spp, true, true, scratch);
         }
-        band.pixels.push(sum / s.spp as f32);
+        band.pixels.push(sum / n as f32);
         if with_gt {
             let before = band.modes.len();
             let cam = self.cam;
@@ -342,7 +418,7 @@ impl PixelCtx<'_> {
 
     /// Traces `n` stratified camera samples of the pixel from the streams of `stream`
     /// (camera: pixel positions and transparency keys; path: its own) and returns the sum of
-    /// their radiance. With `all_hits` each sample ray collects every surface and the path
+    /// their radiance and of its squares. With `all_hits` each sample ray collects every surface and the path
     /// starts from the first it keeps; with `gt` those hits also go into the slice accumulator.
     fn samples(
         &self,
@@ -351,18 +427,18 @@ impl PixelCtx<'_> {
         all_hits: bool,
         gt: bool,
         scratch: &mut Scratch,
-    ) -> Vec3 {
+    ) -> Moments {
         let s = self.settings;
         let (view, x, y) = (self.view, self.x, self.y);
         let mut camera = Sampler::new(s.seed, stream, view, x, y, n);
         let mut sampler = Sampler::new(s.seed, stream ^ PATH_STREAM, view, x, y, 1);
-        let mut sum = Vec3::ZERO;
+        let mut moments = Moments::default();
         for i in 0..n {
             sampler.start_sample(i);
             let off = camera.pixel_offset(i);
             let ray = self.rays.ray(x as f32 + off.x, y as f32 + off.y);
             let key = camera.next_key();
-            sum += if all_hits {
+            let radiance = if all_hits {
                 self.sample_all_hits(ray.origin, ray.dir, key, &mut sampler, scratch, gt)
             } else if self.composites() {
                 let (geo, mats) = (&self.scene.geometry, &self.scene.materials);
@@ -386,8 +462,9 @@ impl PixelCtx<'_> {
                 );
                 traced.radiance
             };
+            moments.add(radiance);
         }
-        sum
+        moments
     }
 
     /// Traces every hit of a sample ray and returns the radiance of the surface the colour
@@ -545,5 +622,43 @@ impl PixelCtx<'_> {
             .iter()
             .find(|h| geo.coverage(mats, h, dir) >= 0.5);
         first.map_or(f32::NAN, |h| h.t)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn moments(samples: &[f32]) -> Moments {
+        let mut m = Moments::default();
+        samples.iter().for_each(|&v| m.add(Vec3::splat(v)));
+        m
+    }
+
+    /// Samples 0, 0, 0, 4 (grey): mean 1, sample variance (1 + 1 + 1 + 9) / 3 = 4, standard
+    /// error √(4 / 4) = 1 per channel, 3 over RGB, over √3 of brightness: √3 ≈ 1.732. At a
+    /// quarter of the display scale the error and brightness shrink 4×, the ratio 2×.
+    #[test]
+    fn the_noise_test_matches_hand_computed_values() {
+        let m = moments(&[0.0, 0.0, 0.0, 4.0]);
+        let at = |threshold, display_scale| Adaptive {
+            extra: 8,
+            threshold,
+            display_scale,
+        };
+        assert!(at(1.73, 1.0).wants_more(&m, 4));
+        assert!(!at(1.74, 1.0).wants_more(&m, 4));
+        assert!(at(0.86, 0.25).wants_more(&m, 4));
+        assert!(!at(0.87, 0.25).wants_more(&m, 4));
+        // Off, a single sample (no variance estimate), or no noise at all: never.
+        assert!(
+            !Adaptive {
+                extra: 0,
+                ..at(0.0, 1.0)
+            }
+            .wants_more(&m, 4)
+        );
+        assert!(!at(0.0, 1.0).wants_more(&moments(&[4.0]), 1));
+        assert!(!at(0.0, 1.0).wants_more(&moments(&[0.5; 4]), 4));
     }
 }
