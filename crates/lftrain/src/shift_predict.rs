@@ -17,9 +17,15 @@ use crate::tensors::{tensor4, values};
 /// thesis' training range.
 pub const FALLBACK_RANGE: [f32; 2] = [-3.5, 3.5];
 
-/// The inference shifts for `lf`: `cfg.range` if set, else the scene's `parameters.cfg` range.
+/// The disparity range inference covers for `lf`: `cfg.range` if set, else the scene's
+/// `parameters.cfg` range.
+fn scene_range(cfg: &EpiShiftConfig, lf: &LightField) -> [f32; 2] {
+    cfg.range.or(lf.disparity_range).unwrap_or(FALLBACK_RANGE)
+}
+
+/// The inference shifts for `lf`: every integer shift of its [`scene_range`].
 pub fn scene_shifts(cfg: &EpiShiftConfig, lf: &LightField) -> Vec<i32> {
-    let [lo, hi] = cfg.range.or(lf.disparity_range).unwrap_or(FALLBACK_RANGE);
+    let [lo, hi] = scene_range(cfg, lf);
     let mut shifts = EpiShiftConfig::shifts_for(lo, hi);
     shifts.truncate(MAX_SHIFTS);
     shifts
@@ -35,7 +41,7 @@ pub fn estimate(
     cfg: &EpiShiftConfig,
     device: &Device,
 ) -> ShiftEstimate {
-    let range = cfg.range.or(lf.disparity_range).unwrap_or(FALLBACK_RANGE);
+    let range = scene_range(cfg, lf);
     let k = cfg.coarse_scale(range);
     let mut shifts = scene_shifts(cfg, lf);
     let prior = (k > 1).then(|| {
