@@ -208,6 +208,9 @@ pub struct RenderConfig {
     /// Shared shading: glossy lobes at least this many times as wide as the camera grid's
     /// angle at a point are shared by all views (see `render::cache`).
     pub glossy_share: f64,
+    /// Shared shading: vertices of each fill path whose coupled-irradiance estimates the cache
+    /// keeps (1: the first alone; see `render::cache::CacheSums::add_later`).
+    pub fill_vertices: u32,
     /// Average library textures seen by camera rays over one sample's footprint.
     pub texture_filter: bool,
     /// Light through smooth glass: `caustics` (default, unbiased), `shadows` or `off` (see
@@ -238,6 +241,7 @@ impl Default for RenderConfig {
             cache_spp: 1,
             cache_cell: 1.0,
             glossy_share: 4.0,
+            fill_vertices: 1,
             texture_filter: true,
             glass_light: GlassLight::Caustics,
         }
@@ -391,6 +395,13 @@ impl Config {
             bail!(
                 "render.cache_cell must be 0.05 to 64 pixels, got {}",
                 r.cache_cell
+            );
+        }
+        let max_vertices = crate::render::cache::MAX_FILL_VERTICES;
+        if !(1..=max_vertices).contains(&r.fill_vertices) {
+            bail!(
+                "render.fill_vertices must be 1 to {max_vertices}, got {}",
+                r.fill_vertices
             );
         }
         if !(r.glossy_share.is_finite() && r.glossy_share >= 0.0) {

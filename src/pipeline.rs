@@ -85,6 +85,7 @@ impl RenderJob {
             cache: CacheParams {
                 cell_px: r.cache_cell as f32,
                 glossy_share: r.glossy_share as f32,
+                fill_vertices: r.fill_vertices,
             },
             texture_filter: r.texture_filter,
         }

@@ -51,7 +51,14 @@ pub struct CacheParams {
     /// grid spans at a point is shared; narrower ones are traced per view. 0 shares every
     /// glossy lobe, mirrors included.
     pub glossy_share: f32,
+    /// Vertices of a fill path whose coupled-irradiance estimates the cells keep: 1 is the
+    /// first (the camera's) alone; more adds those of its later surface vertices, up to
+    /// [`MAX_FILL_VERTICES`] (see [`CacheSums::add_later`]).
+    pub fill_vertices: u32,
 }
+
+/// The most vertices of one fill path that feed the cache.
+pub const MAX_FILL_VERTICES: u32 = 8;
 
 /// The grid cells of a scene: where a point's cell is, from the centre camera's footprint.
 #[derive(Clone, Copy, Debug)]
@@ -62,6 +69,8 @@ pub struct CacheGrid {
     cell_per_depth: f64,
     /// `glossy_share` times the distance between the grid's outermost cameras (metres).
     shared_lobe_span: f64,
+    /// [`CacheParams::fill_vertices`].
+    pub fill_vertices: u32,
 }
 
 impl CacheGrid {
@@ -73,6 +82,7 @@ impl CacheGrid {
             forward: cam.forward,
             cell_per_depth: params.cell_px as f64 / cam.f_px(),
             shared_lobe_span: params.glossy_share as f64 * gx.hypot(gy) * cam.baseline_m,
+            fill_vertices: params.fill_vertices.clamp(1, MAX_FILL_VERTICES),
         }
     }
 
@@ -260,6 +270,8 @@ impl CellSums {
 #[derive(Default)]
 pub struct CacheSums {
     cells: KeyMap<CellSums>,
+    /// The coupled irradiance estimated at later vertices of fill paths: sum and count.
+    later: KeyMap<(Vec3, u32)>,
 }
 
 impl CacheSums {
@@ -276,15 +288,40 @@ impl CacheSums {
         }
     }
 
+    /// Adds a coupled irradiance `estimate` made at a later vertex of a fill path (one the
+    /// path reached by a bounce) to the cells `keys` of that vertex. `I(x)` does not depend
+    /// on where the light leaving `x` goes, so such an estimate is as good a sample of a
+    /// cell's `I` as a camera path's first vertex makes: the bounces of the fill paths the
+    /// cache traces anyway, free samples (the way neural radiance caches train on every
+    /// vertex of a path, Müller et al. 2021). Only cells some first vertex filled keep them
+    /// ([`Self::finish`]): the others no view ever reads.
+    pub fn add_later(&mut self, keys: &[u64], estimate: Vec3) {
+        for &key in keys {
+            let (sum, n) = self.later.entry(key).or_default();
+            (*sum, *n) = (*sum + estimate, *n + 1);
+        }
+    }
+
     /// Adds `other`'s sums cell by cell (call in a fixed order for reproducible sums).
     pub fn merge(&mut self, other: CacheSums) {
         for (key, sums) in other.cells {
             self.cells.entry(key).or_default().add(&sums);
         }
+        for (key, (sum, n)) in other.later {
+            let (s, c) = self.later.entry(key).or_default();
+            (*s, *c) = (*s + sum, *c + n);
+        }
     }
 
-    /// The means per cell.
-    pub fn finish(self, grid: CacheGrid) -> RadianceCache {
+    /// The means per cell (each cell adds its later-vertex sums once: the same sums in any
+    /// order of the keys).
+    pub fn finish(mut self, grid: CacheGrid) -> RadianceCache {
+        for (key, (sum, n)) in self.later {
+            if let Some(cell) = self.cells.get_mut(&key) {
+                cell.irradiance.0 += sum;
+                cell.irradiance.1 += n;
+            }
+        }
         let cells = (self.cells.into_iter())
             .map(|(k, sums)| (k, sums.mean()))
             .collect();
@@ -455,6 +492,7 @@ mod tests {
     const PARAMS: CacheParams = CacheParams {
         cell_px: 1.0,
         glossy_share: 4.0,
+        fill_vertices: 1,
     };
 
     #[test]

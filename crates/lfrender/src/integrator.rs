@@ -4,7 +4,7 @@
 
 use super::RenderScene;
 use super::bsdf::{Frame, Lobes, power_heuristic};
-use super::cache::{COARSER, CacheGrid, Estimate, RadianceCache};
+use super::cache::{COARSER, CacheGrid, Estimate, MAX_FILL_VERTICES, RadianceCache};
 use super::geometry::Hit;
 use super::sampler::Sampler;
 use glam::{Vec2, Vec3};
@@ -110,7 +110,100 @@ pub struct Traced {
     /// With [`Shading::Fill`]: the cells (one per level) of the first non-delta vertex and the
     /// estimate made there (none if the path never reached one).
     pub fill: Option<([u64; COARSER + 1], Estimate)>,
+    /// With [`Shading::Fill`]: the coupled irradiance estimated at later surface vertices.
+    pub later: Later,
 }
+
+/// The cells of one later vertex of a fill path, and its coupled irradiance estimate.
+#[derive(Clone, Copy, Default)]
+struct LaterVertex {
+    cells: [u64; COARSER + 1],
+    /// The path's throughput since this vertex, for the coupled-irradiance integrand.
+    weight: Vec3,
+    irradiance: Vec3,
+    /// The loop depth whose vertex only adds the light it hits to this estimate.
+    last: u32,
+}
+
+/// Coupled-irradiance estimates a fill path makes at its later surface vertices
+/// ([`super::cache::CacheSums::add_later`]). Each is the path's own estimator with the
+/// vertex's BSDF replaced by the coupled-irradiance integrand `(1 − E(μi))`: the same light
+/// sample (its MIS weight against the BSDF pdf the path really sampled), and the same
+/// continuation, weighted by the integrand over that pdf. So the light the path gathers after
+/// a vertex is added to it with its own throughput. Allocation-free: at most
+/// [`MAX_FILL_VERTICES`] − 1.
+#[derive(Clone, Copy, Default)]
+pub struct Later {
+    vertices: [LaterVertex; MAX_FILL_VERTICES as usize - 1],
+    len: usize,
+}
+
+impl Later {
+    /// The estimates: cells and coupled irradiance.
+    pub fn estimates(&self) -> impl Iterator<Item = (&[u64; COARSER + 1], Vec3)> {
+        self.vertices[..self.len]
+            .iter()
+            .map(|v| (&v.cells, v.irradiance))
+    }
+
+    /// Light `l` a vertex at `depth` samples (light samples, with the path's throughput so
+    /// far) counts for every estimate it has not ended for, with theirs.
+    fn gather(&mut self, l: Vec3, depth: u32) {
+        for v in self.vertices[..self.len].iter_mut() {
+            if depth < v.last {
+                v.irradiance += v.weight * l;
+            }
+        }
+    }
+
+    /// Light `l` the path hits on arriving at `depth` (an emitter, the environment).
+    fn arrive(&mut self, l: Vec3, depth: u32) {
+        for v in self.vertices[..self.len].iter_mut() {
+            if depth <= v.last {
+                v.irradiance += v.weight * l;
+            }
+        }
+    }
+
+    /// Whether an estimate still gathers light past the vertex at `depth`.
+    fn open_beyond(&self, depth: u32) -> bool {
+        self.vertices[..self.len].iter().any(|v| depth < v.last)
+    }
+
+    /// The largest throughput of the estimates that gather past `depth`.
+    fn weight_beyond(&self, depth: u32) -> f32 {
+        (self.vertices[..self.len].iter())
+            .filter(|v| depth < v.last)
+            .map(|v| v.weight.max_element())
+            .fold(0.0, f32::max)
+    }
+
+    /// Every open estimate's throughput times `f`, as the path's.
+    fn scale(&mut self, f: Vec3) {
+        for v in &mut self.vertices[..self.len] {
+            v.weight *= f;
+        }
+    }
+
+    /// A new estimate at a vertex with cells `cells`, its light sample's share `direct` (its
+    /// throughput is set once the path has sampled its continuation), gathering up to the
+    /// vertex at loop depth `last`.
+    fn open(&mut self, cells: [u64; COARSER + 1], direct: Vec3, last: u32) {
+        self.vertices[self.len] = LaterVertex {
+            cells,
+            weight: Vec3::ZERO,
+            irradiance: direct,
+            last,
+        };
+        self.len += 1;
+    }
+}
+
+/// A later vertex opens an estimate only where the path samples its diffuse lobe at least
+/// half the time: the estimate weighs the path's continuation by the integrand over the whole
+/// BSDF's pdf, at most `π (1 − E) / (1 − q)` for a glossy share `q`, which a dark diffuse
+/// under a bright lobe would blow up into fireflies in the cell.
+const LATER_MAX_GLOSSY: f32 = 0.5;
 
 impl RenderScene {
     /// Radiance arriving along `dir` at `origin`, given the first surface already chosen
@@ -146,6 +239,13 @@ impl RenderScene {
             from: origin,
         };
         let (mut pending, mut fill) = (!matches!(shading, Shading::Independent), None);
+        let mut later = Later::default();
+        // The loop depth of the fill's first vertex.
+        let mut first_depth = 0;
+        let later_max = match shading {
+            Shading::Fill(grid) => grid.fill_vertices as usize - 1,
+            _ => 0,
+        };
         // Camera-ray length so far while only delta vertices were passed (texture filter).
         let mut camera_length = Some(0.0f32);
         // Whether the path left a surface vertex (one with a light sample) and has refracted
@@ -157,16 +257,23 @@ impl RenderScene {
         // picks up the light it hits, the MIS partner of that vertex's light sample (as pbrt
         // and Mitsuba do). A light sample taking all the direct light alone instead would be
         // unbiased too, but fires on glossy surfaces: its pdf knows nothing of the lobe.
-        for depth in 0..=settings.max_depth {
+        // Past it the path goes on only for the estimates of its later vertices (each as many
+        // vertices beyond its own as the fill's first vertex has).
+        for depth in 0.. {
             sampler.start_vertex(depth);
+            let own = depth <= settings.max_depth;
             let Some(h) = hit else {
-                radiance += beta * self.environment;
+                radiance += beta * self.environment * own as u32 as f32;
+                later.arrive(self.environment, depth);
                 break;
             };
             if !(drop_caustics && refracted) {
-                radiance += beta * self.emitted(&h, dir, arrival);
+                let emitted = self.emitted(&h, dir, arrival);
+                radiance += beta * emitted * own as u32 as f32;
+                later.arrive(emitted, depth);
             }
-            if depth == settings.max_depth {
+            let own = depth < settings.max_depth;
+            if !own && !later.open_beyond(depth) {
                 break;
             }
             let p = origin + dir * h.t;
@@ -186,6 +293,13 @@ impl RenderScene {
             // Probability that this vertex continues by BSDF sampling (below 1 only for the
             // glossy lobe of a cached vertex): the BSDF strategy's pdf for MIS is scaled by it.
             let mut select = 1.0;
+            // A later vertex of a fill path that estimates its coupled irradiance too.
+            let opens = own
+                && fill.is_some()
+                && later.len < later_max
+                && !bsdf.is_delta()
+                && wo_l.z > 0.0
+                && bsdf.specular_probability(wo_l) <= LATER_MAX_GLOSSY;
             if pending && !bsdf.is_delta() {
                 pending = false;
                 match shading {
@@ -196,6 +310,7 @@ impl RenderScene {
                         let glossy = self.fills_glossy(grid, p, &bsdf, wo_l, sampler);
                         let cells = grid.keys(p, frame.n, s.material);
                         fill = Some((cells, glossy));
+                        first_depth = depth;
                         (radiance, beta, lobes) = match glossy {
                             true => {
                                 let albedo = bsdf.specular_albedo(wo_l);
@@ -236,12 +351,28 @@ impl RenderScene {
                 bsdf: &bsdf,
                 through_glass,
             };
+            // The light samples: the path's, and where this vertex opens an estimate the same
+            // samples' coupled-irradiance share.
+            let mut direct = Vec3::ZERO;
             if !bsdf.is_delta() && !self.lights.is_empty() {
                 let strategy = (lobes, select);
-                radiance += beta * self.direct_light(&vertex, strategy, sampler);
+                let (l, coupled) = self.direct_light(&vertex, strategy, opens, sampler);
+                radiance += beta * l * own as u32 as f32;
+                later.gather(l, depth);
+                direct += coupled;
             }
             if !bsdf.is_delta() && !self.punctual_lights.is_empty() {
-                radiance += beta * self.punctual_light(&vertex, lobes);
+                let (l, coupled) = self.punctual_light(&vertex, lobes, opens);
+                radiance += beta * l * own as u32 as f32;
+                later.gather(l, depth);
+                direct += coupled;
+            }
+            if opens {
+                let cells = match shading {
+                    Shading::Fill(grid) => grid.keys(p, frame.n, s.material),
+                    _ => unreachable!("only fill paths open estimates"),
+                };
+                later.open(cells, direct, depth + settings.max_depth - first_depth);
             }
             if select < 1.0 {
                 if sampler.next_f32() >= select {
@@ -256,7 +387,13 @@ impl RenderScene {
             if bs.pdf <= 0.0 {
                 break;
             }
-            beta *= bs.f * bs.wi.z.abs() / bs.pdf;
+            let f = bs.f * bs.wi.z.abs() / bs.pdf;
+            beta *= f;
+            later.scale(f);
+            if opens {
+                let (coupling, _) = bsdf.eval_lobes(wo_l, bs.wi, Lobes::CoupledIrradiance);
+                later.vertices[later.len - 1].weight = coupling * bs.wi.z.abs() / bs.pdf;
+            }
             if !bs.is_delta {
                 camera_length = None;
             }
@@ -274,11 +411,15 @@ impl RenderScene {
                 from: p,
             };
             if depth + 1 >= settings.rr_depth {
-                let survive = beta.max_element().min(0.95);
+                // The roulette keeps the path as likely as its largest weight asks, the open
+                // estimates' included: their weight is not the path's (it restarts at each).
+                let own_weight = if own { beta.max_element() } else { 0.0 };
+                let survive = own_weight.max(later.weight_beyond(depth)).min(0.95);
                 if sampler.next_f32() >= survive {
                     break;
                 }
                 beta /= survive;
+                later.scale(Vec3::splat(survive.recip()));
             }
             dir = frame.to_world(bs.wi);
             origin = self.spawn(p, h.tri, dir);
@@ -297,6 +438,7 @@ impl RenderScene {
         Traced {
             radiance,
             fill: fill.map(|(cells, glossy)| (cells, estimate(glossy))),
+            later,
         }
     }
 
@@ -343,13 +485,16 @@ impl RenderScene {
     }
 
     /// One light sample with a shadow ray through semi-transparent surfaces, MIS-weighted
-    /// against BSDF sampling of `lobes`, which the path takes with probability `select`.
+    /// against BSDF sampling of `lobes`, which the path takes with probability `select`; and
+    /// with `coupled`, the same sample's estimate of the coupled irradiance ([`Later`]).
     fn direct_light(
         &self,
         v: &Vertex,
         (lobes, select): (Lobes, f32),
+        coupled: bool,
         sampler: &mut Sampler,
-    ) -> Vec3 {
+    ) -> (Vec3, Vec3) {
+        const NONE: (Vec3, Vec3) = (Vec3::ZERO, Vec3::ZERO);
         let (p, frame, wo_l, bsdf) = (v.p, v.frame, v.wo_l, v.bsdf);
         let ls = self.lights.sample(
             &self.geometry,
@@ -363,20 +508,24 @@ impl RenderScene {
         let wi = to_light / dist;
         let cos_light = -wi.dot(ls.n);
         if cos_light <= 0.0 || dist <= 0.0 {
-            return Vec3::ZERO;
+            return NONE;
         }
         let wi_l = frame.to_local(wi);
         let (f, bsdf_pdf) = bsdf.eval_lobes(wo_l, wi_l, lobes);
         let bsdf_pdf = bsdf_pdf * select;
-        if f == Vec3::ZERO {
-            return Vec3::ZERO;
+        let f_coupled = match coupled {
+            true => bsdf.eval_lobes(wo_l, wi_l, Lobes::CoupledIrradiance).0,
+            false => Vec3::ZERO,
+        };
+        if f == Vec3::ZERO && f_coupled == Vec3::ZERO {
+            return NONE;
         }
         // Aim just off the light, on the side facing `p`: a ray that reached the light's
         // surface could count the light itself as the occluder.
         let target = ls.p + ls.n * ray_eps(ls.p);
         let (tr, crossed_glass) = self.visibility(p, v.hit.tri, target, v.through_glass);
         if tr == Vec3::ZERO {
-            return Vec3::ZERO;
+            return NONE;
         }
         let light_pdf = ls.pdf_area * dist * dist / cos_light;
         // Through glass the BSDF partner refracts and is dropped: the light sample is alone.
@@ -384,21 +533,27 @@ impl RenderScene {
             true => 1.0,
             false => power_heuristic(light_pdf, bsdf_pdf),
         };
-        f * ls.emission * (tr * wi_l.z.abs() * weight / light_pdf)
+        let incident = ls.emission * (tr * wi_l.z.abs() * weight / light_pdf);
+        (f * incident, f_coupled * incident)
     }
 
     /// Light from every punctual light, each with a shadow ray through semi-transparent
-    /// surfaces. A delta light has no MIS partner: no BSDF sample can hit it.
-    fn punctual_light(&self, v: &Vertex, lobes: Lobes) -> Vec3 {
+    /// surfaces. A delta light has no MIS partner: no BSDF sample can hit it. With `coupled`,
+    /// also the coupled irradiance it gives ([`Later`]).
+    fn punctual_light(&self, v: &Vertex, lobes: Lobes, coupled: bool) -> (Vec3, Vec3) {
         let (p, frame, wo_l, bsdf, tri) = (v.p, v.frame, v.wo_l, v.bsdf, v.hit.tri);
-        let mut sum = Vec3::ZERO;
+        let (mut sum, mut sum_coupled) = (Vec3::ZERO, Vec3::ZERO);
         for light in &self.punctual_lights {
             let Some(inc) = light.incident(p) else {
                 continue;
             };
             let wi_l = frame.to_local(inc.wi);
             let (f, _) = bsdf.eval_lobes(wo_l, wi_l, lobes);
-            if f == Vec3::ZERO {
+            let f_coupled = match coupled {
+                true => bsdf.eval_lobes(wo_l, wi_l, Lobes::CoupledIrradiance).0,
+                false => Vec3::ZERO,
+            };
+            if f == Vec3::ZERO && f_coupled == Vec3::ZERO {
                 continue;
             }
             let glass = v.through_glass;
@@ -410,9 +565,11 @@ impl RenderScene {
                     geo.transmittance(&self.materials, origin, inc.wi, f32::INFINITY, glass)
                 }
             };
-            sum += f * inc.irradiance * (tr * wi_l.z.abs());
+            let incident = inc.irradiance * (tr * wi_l.z.abs());
+            sum += f * incident;
+            sum_coupled += f_coupled * incident;
         }
-        sum
+        (sum, sum_coupled)
     }
 
     /// Shading normal; opaque surfaces are two-sided, so it is turned towards the viewer.

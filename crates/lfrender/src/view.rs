@@ -259,6 +259,9 @@ impl RenderScene {
             if let Some((cells, estimate)) = traced.fill {
                 sums.add(&cells, estimate, uv);
             }
+            for (cells, irradiance) in traced.later.estimates() {
+                sums.add_later(cells, irradiance);
+            }
         }
     }
 
