@@ -286,6 +286,9 @@ pub const PRESETS: &[(&str, &[&str])] = &[
 pub const MAX_SPP: u32 = 1 << 16;
 /// Longest path.
 pub const MAX_DEPTH: u32 = 1024;
+/// The range of `render.exposure`: twenty stops either way, far inside f32.
+const MIN_EXPOSURE: f64 = 1e-6;
+const MAX_EXPOSURE: f64 = 1e6;
 
 /// Where a config's values came from, for its errors: the file (or the defaults) and every
 /// preset and `--set` applied over it, so a bad `--set` is not blamed on the defaults.
@@ -419,8 +422,18 @@ impl Config {
                 r.max_depth
             );
         }
-        if !(0.0..1.0).contains(&r.mode_epsilon) || !r.exposure.is_finite() || r.exposure <= 0.0 {
-            bail!("render.mode_epsilon must be in [0, 1) and render.exposure positive");
+        if !(0.0..1.0).contains(&r.mode_epsilon) {
+            bail!(
+                "render.mode_epsilon must be in [0, 1), got {}",
+                r.mode_epsilon
+            );
+        }
+        // The scene stores it as f32: 1e308 is finite here and infinite there.
+        if !(MIN_EXPOSURE..=MAX_EXPOSURE).contains(&r.exposure) {
+            bail!(
+                "render.exposure must be {MIN_EXPOSURE:e} to {MAX_EXPOSURE:e}, got {}",
+                r.exposure
+            );
         }
         if r.adaptive_spp > MAX_SPP || r.adaptive_threshold.is_nan() || r.adaptive_threshold < 0.0 {
             bail!(

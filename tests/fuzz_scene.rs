@@ -190,6 +190,9 @@ fn hostile_config_values_are_refused_with_the_key_named() {
         "scene.environment=[1e308,0,0]",
         "scene.room_width=[1,1e25]",
         "scene.objects=4294967295",
+        "render.exposure=1e308",
+        "render.fill_vertices=0",
+        "render.fill_vertices=9",
     ];
     for set in cases {
         let d = tempfile::tempdir().unwrap();
