@@ -8,8 +8,9 @@ mod common;
 use common::{Harness, Part, camera, disparity, emitter, f_px, matte, quad, scene, settings};
 use glam::{DVec3, Quat, Vec3};
 use lfgen::output::images::to_srgb8;
+use lfgen::render::cache::{CacheParams, RadianceCache};
 use lfgen::render::view::{Adaptive, RenderSettings};
-use lfgen::scene::{Material, SceneDesc, SurfaceModel, Texture, Transform};
+use lfgen::scene::{Material, SceneDesc, Shape, SurfaceModel, Texture, Transform};
 
 const EYE: DVec3 = DVec3::new(0.0, 1.0, 4.0);
 /// The plane's depth and its (integer) disparity: views are integer shifts of each other.
@@ -361,4 +362,96 @@ fn adaptive_sampling_refines_the_noisy_pixels() {
         "refined {noisy:.2e} vs kept {quiet:.2e}"
     );
     assert!(after < 0.5 * before, "MSE {before:.2e} → {after:.2e}");
+}
+
+/// A furnace: a closed Lambert room of albedo `FURNACE_ALBEDO` whose every wall also emits
+/// radiance 1. Light arriving anywhere from any direction is then known in closed form (the
+/// emission after 0, 1, … bounces), and so is every cell's coupled irradiance.
+const FURNACE_ALBEDO: f32 = 0.5;
+
+fn furnace() -> Harness {
+    let cam = camera([64, 64], [5, 5], 35.0, DVec3::new(0.0, 1.5, 2.0));
+    let walls = Material {
+        model: SurfaceModel::Diffuse,
+        emission: [1.0; 3],
+        ..matte([FURNACE_ALBEDO; 3], 1.0)
+    };
+    let room = Part {
+        shape: Shape::Room {
+            size: Vec3::new(4.0, 3.0, 6.0),
+        },
+        transform: Transform::at(Vec3::ZERO),
+        material: walls,
+    };
+    Harness::new(scene(cam, [1.0, 5.2], [0.0; 3], vec![room]))
+}
+
+/// The coupled irradiance of the finest cells on the furnace's back wall (z = −3, facing +Z)
+/// that the cache filled.
+fn back_wall_cells(cache: &RadianceCache) -> Vec<f64> {
+    let mut seen = std::collections::HashSet::new();
+    let mut cells = Vec::new();
+    for iy in 0..60 {
+        for ix in 0..80 {
+            let p = Vec3::new(-1.95 + ix as f32 * 0.05, 0.05 + iy as f32 * 0.05, -3.0);
+            let key = cache.grid.keys(p, Vec3::Z, 0)[0];
+            let irradiance = cache.get(key).and_then(|c| c.irradiance);
+            if let (true, Some(i)) = (seen.insert(key), irradiance) {
+                cells.push(i.x as f64);
+            }
+        }
+    }
+    cells
+}
+
+/// The later vertices of the fill paths (`render.fill_vertices`) estimate the same coupled
+/// irradiance as their first: in the furnace, where every cell's value is known, the cells
+/// stay on the closed form with and without Russian roulette (a later estimate weighted as
+/// the path, or cut off at the path's depth, would be dark), and they scatter less about it
+/// since each holds more samples.
+#[test]
+fn later_fill_vertices_agree_with_the_furnace_and_cut_its_noise() {
+    let h = furnace();
+    let max_depth = 5u32;
+    // What arrives after 0…max_depth−1 bounces, times π (the cosine-weighted hemisphere).
+    let arriving: f64 = (0..max_depth as i32)
+        .map(|k| (FURNACE_ALBEDO as f64).powi(k))
+        .sum();
+    let truth = std::f64::consts::PI * arriving;
+    for rr_depth in [max_depth + 1, 2] {
+        let s = RenderSettings {
+            path: lfgen::render::integrator::PathSettings {
+                rr_depth,
+                ..settings(1, max_depth).path
+            },
+            ..settings(1, max_depth)
+        };
+        let spread = |fill_vertices| {
+            let params = CacheParams {
+                fill_vertices,
+                ..common::CACHE
+            };
+            let cells = back_wall_cells(&h.cache_with(&s, 1, params));
+            let n = cells.len() as f64;
+            let mean = cells.iter().sum::<f64>() / n;
+            let rms = (cells.iter().map(|i| (i / truth - 1.0).powi(2)).sum::<f64>() / n).sqrt();
+            eprintln!(
+                "rr_depth {rr_depth}, fill_vertices {fill_vertices}: {n} cells, mean {:.4} of \
+                 the truth, rms {rms:.4}",
+                mean / truth
+            );
+            // The mean of hundreds of cells: its own noise is about 0.1 %.
+            assert!(n > 200.0, "{n} cells");
+            assert!(
+                (mean / truth - 1.0).abs() < 0.005,
+                "rr_depth {rr_depth}, fill_vertices {fill_vertices}: mean {mean} vs {truth}"
+            );
+            rms
+        };
+        let (first, later) = (spread(1), spread(5));
+        assert!(
+            later < 0.85 * first,
+            "rr_depth {rr_depth}: rms {later:.4} with later vertices vs {first:.4}"
+        );
+    }
 }

@@ -189,9 +189,18 @@ impl Harness {
     /// The shared-shading cache from `spp` fill samples per pixel of every view, with the
     /// default cells and sharing ([`CACHE`]).
     pub fn cache(&self, settings: &RenderSettings, spp: u32) -> RadianceCache {
+        self.cache_with(settings, spp, CACHE)
+    }
+
+    /// A shared-shading cache with its own cache parameters.
+    pub fn cache_with(
+        &self,
+        settings: &RenderSettings,
+        spp: u32,
+        params: CacheParams,
+    ) -> RadianceCache {
         let cam = &self.desc.camera;
-        self.scene
-            .fill_cache(cam, settings, spp, CACHE, &AtomicU64::new(0))
+        (self.scene).fill_cache(cam, settings, spp, params, &AtomicU64::new(0))
     }
 
     /// A view with shared shading from `cache`.

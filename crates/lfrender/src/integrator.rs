@@ -261,17 +261,23 @@ impl RenderScene {
         // vertices beyond its own as the fill's first vertex has).
         for depth in 0.. {
             sampler.start_vertex(depth);
-            let own = depth <= settings.max_depth;
+            // Whether the path's own estimate still takes the light it reaches here.
+            let arrives = depth <= settings.max_depth;
             let Some(h) = hit else {
-                radiance += beta * self.environment * own as u32 as f32;
+                if arrives {
+                    radiance += beta * self.environment;
+                }
                 later.arrive(self.environment, depth);
                 break;
             };
             if !(drop_caustics && refracted) {
                 let emitted = self.emitted(&h, dir, arrival);
-                radiance += beta * emitted * own as u32 as f32;
+                if arrives {
+                    radiance += beta * emitted;
+                }
                 later.arrive(emitted, depth);
             }
+            // Whether this vertex is one of the path's own (else it serves the open estimates).
             let own = depth < settings.max_depth;
             if !own && !later.open_beyond(depth) {
                 break;
@@ -357,13 +363,17 @@ impl RenderScene {
             if !bsdf.is_delta() && !self.lights.is_empty() {
                 let strategy = (lobes, select);
                 let (l, coupled) = self.direct_light(&vertex, strategy, opens, sampler);
-                radiance += beta * l * own as u32 as f32;
+                if own {
+                    radiance += beta * l;
+                }
                 later.gather(l, depth);
                 direct += coupled;
             }
             if !bsdf.is_delta() && !self.punctual_lights.is_empty() {
                 let (l, coupled) = self.punctual_light(&vertex, lobes, opens);
-                radiance += beta * l * own as u32 as f32;
+                if own {
+                    radiance += beta * l;
+                }
                 later.gather(l, depth);
                 direct += coupled;
             }

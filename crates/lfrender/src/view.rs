@@ -229,7 +229,7 @@ impl RenderScene {
                     sums
                 })
                 .collect();
-            bands.into_iter().for_each(|b| all.merge(b));
+            all.merge_view(bands);
         }
         all.finish(grid)
     }
