@@ -241,7 +241,7 @@ impl Default for RenderConfig {
             cache_spp: 1,
             cache_cell: 1.0,
             glossy_share: 4.0,
-            fill_vertices: 1,
+            fill_vertices: 5,
             texture_filter: true,
             glass_light: GlassLight::Caustics,
         }

@@ -40,12 +40,12 @@ pub fn camera(
     }
 }
 
-/// The cache parameters of the tests (`render.cache_cell`, `render.glossy_share`: the
-/// defaults; `render.fill_vertices`: the first vertex alone, the fill the tests were written for).
+/// The default cache parameters (`render.cache_cell`, `render.glossy_share`,
+/// `render.fill_vertices`).
 pub const CACHE: CacheParams = CacheParams {
     cell_px: 1.0,
     glossy_share: 4.0,
-    fill_vertices: 1,
+    fill_vertices: 5,
 };
 
 /// Focal length in pixels, from docs/conventions.md, Camera (not from the code under test).
