@@ -543,8 +543,10 @@ impl RenderScene {
             true => 1.0,
             false => power_heuristic(light_pdf, bsdf_pdf),
         };
-        let incident = ls.emission * (tr * wi_l.z.abs() * weight / light_pdf);
-        (f * incident, f_coupled * incident)
+        // Multiplied in the order of the path's own estimate before `coupled` existed, so
+        // its images are bit for bit those of then.
+        let share = tr * wi_l.z.abs() * weight / light_pdf;
+        (f * ls.emission * share, f_coupled * ls.emission * share)
     }
 
     /// Light from every punctual light, each with a shadow ray through semi-transparent
@@ -575,9 +577,9 @@ impl RenderScene {
                     geo.transmittance(&self.materials, origin, inc.wi, f32::INFINITY, glass)
                 }
             };
-            let incident = inc.irradiance * (tr * wi_l.z.abs());
-            sum += f * incident;
-            sum_coupled += f_coupled * incident;
+            let share = tr * wi_l.z.abs();
+            sum += f * inc.irradiance * share;
+            sum_coupled += f_coupled * inc.irradiance * share;
         }
         (sum, sum_coupled)
     }
