@@ -209,7 +209,8 @@ pub struct RenderConfig {
     /// angle at a point are shared by all views (see `render::cache`).
     pub glossy_share: f64,
     /// Shared shading: vertices of each fill path whose coupled-irradiance estimates the cache
-    /// keeps (1: the first alone; see `render::cache::CacheSums::add_later`).
+    /// keeps (1: the first alone; see `render::cache::CacheSums::add_later`). Only the path's
+    /// own vertices, below `max_depth`, take part: larger values act as `max_depth`.
     pub fill_vertices: u32,
     /// Average library textures seen by camera rays over one sample's footprint.
     pub texture_filter: bool,
