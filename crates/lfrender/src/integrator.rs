@@ -197,6 +197,11 @@ impl Later {
         };
         self.len += 1;
     }
+
+    /// The throughput of the estimate opened last, once its vertex sampled its continuation.
+    fn weigh_newest(&mut self, weight: Vec3) {
+        self.vertices[self.len - 1].weight = weight;
+    }
 }
 
 /// A later vertex opens an estimate only where the path samples its diffuse lobe at least
@@ -242,10 +247,12 @@ impl RenderScene {
         let mut later = Later::default();
         // The loop depth of the fill's first vertex.
         let mut first_depth = 0;
-        let later_max = match shading {
-            Shading::Fill(grid) => grid.fill_vertices as usize - 1,
-            _ => 0,
+        // The grid of a fill path, whose later vertices open estimates of their own.
+        let fill_grid = match shading {
+            Shading::Fill(grid) => Some(grid),
+            _ => None,
         };
+        let later_max = fill_grid.map_or(0, |grid| grid.fill_vertices as usize - 1);
         // Camera-ray length so far while only delta vertices were passed (texture filter).
         let mut camera_length = Some(0.0f32);
         // Whether the path left a surface vertex (one with a light sample) and has refracted
@@ -377,11 +384,8 @@ impl RenderScene {
                 later.gather(l, depth);
                 direct += coupled;
             }
-            if opens {
-                let cells = match shading {
-                    Shading::Fill(grid) => grid.keys(p, frame.n, s.material),
-                    _ => unreachable!("only fill paths open estimates"),
-                };
+            if let (true, Some(grid)) = (opens, fill_grid) {
+                let cells = grid.keys(p, frame.n, s.material);
                 later.open(cells, direct, depth + settings.max_depth - first_depth);
             }
             if select < 1.0 {
@@ -402,7 +406,7 @@ impl RenderScene {
             later.scale(f);
             if opens {
                 let (coupling, _) = bsdf.eval_lobes(wo_l, bs.wi, Lobes::CoupledIrradiance);
-                later.vertices[later.len - 1].weight = coupling * bs.wi.z.abs() / bs.pdf;
+                later.weigh_newest(coupling * bs.wi.z.abs() / bs.pdf);
             }
             if !bs.is_delta {
                 camera_length = None;
