@@ -547,8 +547,8 @@ impl RenderScene {
             true => 1.0,
             false => power_heuristic(light_pdf, bsdf_pdf),
         };
-        // Multiplied in the order of the path's own estimate before `coupled` existed, so
-        // its images are bit for bit those of then.
+        // The path's own product keeps its factor order, so `fill_vertices = 1` renders bit
+        // for bit what the first-vertex-only estimator rendered (checked on the golden set).
         let share = tr * wi_l.z.abs() * weight / light_pdf;
         (f * ls.emission * share, f_coupled * ls.emission * share)
     }
