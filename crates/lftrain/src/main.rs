@@ -10,6 +10,13 @@ use lftrain::loader::PoolConfig;
 use lftrain::predict::predict_dataset_over;
 use lftrain::train::{TrainArgs, bench_loader, bench_steps, train};
 
+/// Training allocates and frees every activation and gradient tensor each step. With glibc's
+/// allocator those large blocks go back to the kernel and fault in again as zeroed pages on the
+/// next step: a quarter of a CPU step's time was page faults and `brk` (perf, `lftrain bench
+/// --config configs/cpu_field.toml`). mimalloc keeps them in its own pools.
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 #[derive(Parser)]
 #[command(
     version,
