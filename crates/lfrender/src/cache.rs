@@ -130,6 +130,12 @@ impl CacheGrid {
 /// then blurs over 2 or 4 cells instead of falling back to a full, noisy path per sample.
 pub const COARSER: usize = 2;
 
+/// The offset of corner `0..8` of a cell block along x, y, z (bits 0, 1, 2): one convention
+/// for the cells a lookup fetches and the weights it gives them.
+fn corner_offset(corner: usize) -> [usize; 3] {
+    [corner & 1, (corner >> 1) & 1, corner >> 2]
+}
+
 /// `p` in units of the cell size of `level`.
 fn cell_units(p: Vec3, level: i32) -> DVec3 {
     p.as_dvec3() / 2f64.powi(level)
@@ -420,7 +426,7 @@ impl RadianceCache {
             let (mut irradiance, mut glossy) = ((Vec3::ZERO, 0.0), (GlossyFit::default(), 0.0));
             for (corner, cell) in corners.iter().enumerate() {
                 let Some(cell) = cell else { continue };
-                let o = [corner & 1, (corner >> 1) & 1, corner >> 2];
+                let o = corner_offset(corner);
                 let w = [0, 1, 2]
                     .map(|a| if o[a] == 1 { t[a] } else { 1.0 - t[a] })
                     .iter()
@@ -467,8 +473,7 @@ impl RadianceCache {
             let slot = seen.unwrap_or_else(|| {
                 let slot = memo.next;
                 memo.cells[slot] = std::array::from_fn(|corner| {
-                    let c = corner as i64;
-                    let o = I64Vec3::new(c & 1, (c >> 1) & 1, c >> 2);
+                    let o = I64Vec3::from_array(corner_offset(corner).map(|b| b as i64));
                     self.get(self.grid.cell_key(level, base + o, n, material))
                 });
                 memo.ids[slot] = Some(id);
