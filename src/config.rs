@@ -217,6 +217,9 @@ pub struct RenderConfig {
     /// Light through smooth glass: `caustics` (default, unbiased), `shadows` or `off` (see
     /// [`GlassLight`]).
     pub glass_light: GlassLight,
+    /// Shared shading: smooth glass on a camera ray is traced both ways, reflection and
+    /// refraction each with its Fresnel weight, instead of one chosen with that probability.
+    pub split_glass: bool,
 }
 
 impl Default for RenderConfig {
@@ -245,6 +248,7 @@ impl Default for RenderConfig {
             fill_vertices: 5,
             texture_filter: true,
             glass_light: GlassLight::Caustics,
+            split_glass: true,
         }
     }
 }

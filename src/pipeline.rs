@@ -71,6 +71,7 @@ impl RenderJob {
                 rr_depth: r.rr_depth,
                 footprint: 0.0, // per scene: see `settings`
                 glass_light: r.glass_light,
+                split_glass: r.split_glass,
             },
             gt_views: r.gt_views,
             mode_epsilon: r.mode_epsilon as f32,

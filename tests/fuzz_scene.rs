@@ -71,6 +71,7 @@ fn run_in_process(v: Value) -> Outcome {
             rr_depth: 2,
             footprint: 0.0,
             glass_light: lfgen::render::integrator::GlassLight::Caustics,
+            split_glass: true,
         },
         spp: 1,
         gt_spp: 1,

@@ -77,6 +77,7 @@ impl Loaded {
                 rr_depth: 2,
                 footprint: 0.0,
                 glass_light: lfgen::render::integrator::GlassLight::Caustics,
+                split_glass: true,
             },
             spp,
             gt_spp: spp,

@@ -156,6 +156,7 @@ pub fn settings(spp: u32, max_depth: u32) -> RenderSettings {
             rr_depth: max_depth + 1,
             footprint: 0.0,
             glass_light: lfgen::render::integrator::GlassLight::Caustics,
+            split_glass: true,
         },
         spp,
         gt_spp: spp,

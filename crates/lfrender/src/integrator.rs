@@ -45,6 +45,10 @@ pub struct PathSettings {
     pub footprint: f32,
     /// Light through smooth glass (see [`GlassLight`]).
     pub glass_light: GlassLight,
+    /// With shared shading, trace both the reflection and the refraction of smooth glass a
+    /// camera ray meets, each with its Fresnel weight, instead of choosing one with that
+    /// probability ([`RenderScene::reflection`]). Unbiased either way.
+    pub split_glass: bool,
 }
 
 /// Offset for spawning rays off a surface, relative to the scene scale.
@@ -57,6 +61,21 @@ struct Arrival {
     is_delta: bool,
     /// The vertex the path left: light selection depends on the shading point.
     from: Vec3,
+}
+
+/// Where a traced path starts: a camera path at loop depth 0, or the reflection branch of its
+/// glass ([`RenderScene::reflection`]) one vertex later.
+#[derive(Clone, Copy)]
+struct Start {
+    origin: Vec3,
+    dir: Vec3,
+    /// The first surface, from the caller's traversal (`None`: the ray escaped).
+    first: Option<Hit>,
+    depth: u32,
+    /// Camera-ray length before the start (the texture filter's footprint grows with it).
+    camera_length: f32,
+    /// Whether smooth glass on the camera ray is split into its two branches.
+    split: bool,
 }
 
 /// How a camera path treats its first non-delta vertex (see [`super::cache`]).
@@ -235,7 +254,27 @@ impl RenderScene {
         sampler: &mut Sampler,
         shading: Shading,
     ) -> Traced {
-        let (mut origin, mut dir, mut hit) = (origin, dir, first);
+        let start = Start {
+            origin,
+            dir,
+            first,
+            depth: 0,
+            camera_length: 0.0,
+            split: settings.split_glass && matches!(shading, Shading::Read { .. }),
+        };
+        self.trace_from(settings, start, sampler, shading)
+    }
+
+    /// [`Self::trace`] of a path that starts at loop depth `start.depth`: a camera path, or
+    /// the reflection branch of a camera path's glass ([`Self::reflection`]).
+    fn trace_from(
+        &self,
+        settings: &PathSettings,
+        start: Start,
+        sampler: &mut Sampler,
+        shading: Shading,
+    ) -> Traced {
+        let (mut origin, mut dir, mut hit) = (start.origin, start.dir, start.first);
         let mut radiance = Vec3::ZERO;
         let mut beta = Vec3::ONE;
         let mut arrival = Arrival {
@@ -254,7 +293,7 @@ impl RenderScene {
         };
         let later_max = fill_grid.map_or(0, |grid| grid.fill_vertices as usize - 1);
         // Camera-ray length so far while only delta vertices were passed (texture filter).
-        let mut camera_length = Some(0.0f32);
+        let mut camera_length = Some(start.camera_length);
         // Whether the path left a surface vertex (one with a light sample) and has refracted
         // through glass since: light it reaches now is a refractive caustic.
         let (mut left_surface, mut refracted) = (false, false);
@@ -266,7 +305,7 @@ impl RenderScene {
         // unbiased too, but fires on glossy surfaces: its pdf knows nothing of the lobe.
         // Past it the path goes on only for the estimates of its later vertices (each as many
         // vertices beyond its own as the fill's first vertex has).
-        for depth in 0.. {
+        for depth in start.depth.. {
             sampler.start_vertex(depth);
             // Whether the path's own estimate still takes the light it reaches here.
             let arrives = depth <= settings.max_depth;
@@ -394,14 +433,26 @@ impl RenderScene {
                 }
                 beta /= select;
             }
-            let Some(bs) = bsdf.sample_lobes(wo_l, sampler.next_f32(), sampler.next2(), lobes)
-            else {
+            // Glass on the camera ray is split: the path always refracts, and the reflection
+            // is traced as a branch of its own (see [`Self::reflection`]).
+            let split = start.split && bsdf.is_delta() && camera_length.is_some();
+            let u_lobe = sampler.next_f32();
+            let u_lobe = if split { 1.0 } else { u_lobe };
+            let Some(bs) = bsdf.sample_lobes(wo_l, u_lobe, sampler.next2(), lobes) else {
                 break;
             };
             if bs.pdf <= 0.0 {
                 break;
             }
-            let f = bs.f * bs.wi.z.abs() / bs.pdf;
+            let mut f = bs.f * bs.wi.z.abs() / bs.pdf;
+            if split && bs.pdf < 1.0 {
+                // Refraction was sampled with probability `pdf = 1 − F`: both branches now
+                // carry their Fresnel weight instead of being chosen with it.
+                f *= bs.pdf;
+                let length = camera_length.unwrap_or(0.0);
+                let reflected = self.reflection(settings, &vertex, depth, length, sampler, shading);
+                radiance += beta * (1.0 - bs.pdf) * reflected;
+            }
             beta *= f;
             later.scale(f);
             if opens {
@@ -454,6 +505,42 @@ impl RenderScene {
             fill: fill.map(|(cells, glossy)| (cells, estimate(glossy))),
             later,
         }
+    }
+
+    /// Radiance the mirror reflection at glass `v` (loop depth `depth`, camera ray `length`
+    /// long so far) brings back: the branch of a split camera path. Choosing reflection with
+    /// probability F, as the path does elsewhere, leaves the pixel to average how many of its
+    /// samples took it; under a bright reflection (a window in a glass table) that count is
+    /// most of the pixel's noise at 16 spp, and each view counts its own. Tracing both costs
+    /// one ray and mostly one cache lookup. The branch continues at the depth the chosen
+    /// reflection would have, splits no further, and draws from the dimensions of its own
+    /// depths: the pixel's sequence resumes where it was for the path's own decisions.
+    fn reflection(
+        &self,
+        settings: &PathSettings,
+        v: &Vertex,
+        depth: u32,
+        length: f32,
+        sampler: &mut Sampler,
+        shading: Shading,
+    ) -> Vec3 {
+        let resume = sampler.dimension();
+        let wi = Vec3::new(-v.wo_l.x, -v.wo_l.y, v.wo_l.z);
+        let dir = v.frame.to_world(wi);
+        let origin = self.spawn(v.p, v.hit.tri, dir);
+        let key = sampler.next_key();
+        let first = (self.geometry).closest(&self.materials, origin, dir, f32::INFINITY, key);
+        let start = Start {
+            origin,
+            dir,
+            first,
+            depth: depth + 1,
+            camera_length: length,
+            split: false,
+        };
+        let traced = self.trace_from(settings, start, sampler, shading);
+        sampler.resume_at(resume);
+        traced.radiance
     }
 
     /// Whether a fill sample estimates the shared glossy term at its first vertex (else the

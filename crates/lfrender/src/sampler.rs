@@ -112,6 +112,18 @@ impl Sampler {
         self.values[within as usize]
     }
 
+    /// The next dimension to be drawn, for [`Self::resume_at`].
+    #[inline]
+    pub fn dimension(&self) -> u32 {
+        self.dim
+    }
+
+    /// Continues at dimension `dim` (a branch of the path drew others in between).
+    #[inline]
+    pub fn resume_at(&mut self, dim: u32) {
+        self.dim = dim;
+    }
+
     #[inline]
     pub fn next2(&mut self) -> Vec2 {
         Vec2::new(self.next_f32(), self.next_f32())
