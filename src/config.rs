@@ -212,6 +212,9 @@ pub struct RenderConfig {
     /// keeps (1: the first alone; see `render::cache::CacheSums::add_later`). Only the path's
     /// own vertices, below `max_depth`, take part: larger values act as `max_depth`.
     pub fill_vertices: u32,
+    /// Shared shading: light samples each fill path takes at its first vertex, averaged
+    /// (see `render::cache::CacheGrid::fill_light_samples`).
+    pub fill_light_samples: u32,
     /// Average library textures seen by camera rays over one sample's footprint.
     pub texture_filter: bool,
     /// Light through smooth glass: `caustics` (default, unbiased), `shadows` or `off` (see
@@ -246,6 +249,7 @@ impl Default for RenderConfig {
             cache_cell: 1.0,
             glossy_share: 4.0,
             fill_vertices: 5,
+            fill_light_samples: 4,
             texture_filter: true,
             glass_light: GlassLight::Caustics,
             split_glass: true,
@@ -410,6 +414,12 @@ impl Config {
             bail!(
                 "render.fill_vertices must be 1 to {max_vertices}, got {}",
                 r.fill_vertices
+            );
+        }
+        if !(1..=64).contains(&r.fill_light_samples) {
+            bail!(
+                "render.fill_light_samples must be 1 to 64, got {}",
+                r.fill_light_samples
             );
         }
         if !(r.glossy_share.is_finite() && r.glossy_share >= 0.0) {

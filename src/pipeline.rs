@@ -87,6 +87,7 @@ impl RenderJob {
                 cell_px: r.cache_cell as f32,
                 glossy_share: r.glossy_share as f32,
                 fill_vertices: r.fill_vertices,
+                fill_light_samples: r.fill_light_samples,
             },
             texture_filter: r.texture_filter,
         }

@@ -194,6 +194,8 @@ fn hostile_config_values_are_refused_with_the_key_named() {
         "render.exposure=1e308",
         "render.fill_vertices=0",
         "render.fill_vertices=9",
+        "render.fill_light_samples=0",
+        "render.fill_light_samples=65",
     ];
     for set in cases {
         let d = tempfile::tempdir().unwrap();

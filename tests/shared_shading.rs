@@ -418,17 +418,17 @@ fn adaptive_sampling_refines_the_noisy_pixels() {
     assert!(after < 0.5 * before, "MSE {before:.2e} → {after:.2e}");
 }
 
-/// A furnace: a closed Lambert room of albedo `FURNACE_ALBEDO` whose every wall also emits
-/// radiance 1. Light arriving anywhere from any direction is then known in closed form (the
-/// emission after 0, 1, … bounces), and so is every cell's coupled irradiance.
+/// A furnace: a closed Lambert room of albedo `albedo` whose every wall also emits radiance 1.
+/// Light arriving anywhere from any direction is then known in closed form (the emission after
+/// 0, 1, … bounces), and so is every cell's coupled irradiance.
 const FURNACE_ALBEDO: f32 = 0.5;
 
-fn furnace() -> Harness {
+fn furnace(albedo: f32) -> Harness {
     let cam = camera([64, 64], [5, 5], 35.0, DVec3::new(0.0, 1.5, 2.0));
     let walls = Material {
         model: SurfaceModel::Diffuse,
         emission: [1.0; 3],
-        ..matte([FURNACE_ALBEDO; 3], 1.0)
+        ..matte([albedo; 3], 1.0)
     };
     let room = Part {
         shape: Shape::Room {
@@ -440,22 +440,59 @@ fn furnace() -> Harness {
     Harness::new(scene(cam, [1.0, 5.2], [0.0; 3], vec![room]))
 }
 
-/// The coupled irradiance of the finest cells on the furnace's back wall (z = −3, facing +Z)
-/// that the cache filled.
-fn back_wall_cells(cache: &RadianceCache) -> Vec<f64> {
-    let mut seen = std::collections::HashSet::new();
-    let mut cells = Vec::new();
+/// The finest cells on the back wall (z = −3, facing +Z) that the cache filled: each cell's
+/// coupled irradiance over `truth` averaged across the wall points (a 5 cm grid) inside it,
+/// the area its fill samples cover.
+fn back_wall_ratios(cache: &RadianceCache, truth: impl Fn(Vec3) -> f64) -> Vec<f64> {
+    let mut cells = std::collections::HashMap::new();
     for iy in 0..60 {
         for ix in 0..80 {
             let p = Vec3::new(-1.95 + ix as f32 * 0.05, 0.05 + iy as f32 * 0.05, -3.0);
             let key = cache.grid.keys(p, Vec3::Z, 0)[0];
-            let irradiance = cache.get(key).and_then(|c| c.irradiance);
-            if let (true, Some(i)) = (seen.insert(key), irradiance) {
-                cells.push(i.x as f64);
+            if let Some(i) = cache.get(key).and_then(|c| c.irradiance) {
+                let cell = cells.entry(key).or_insert((i.x as f64, 0.0, 0.0));
+                (cell.1, cell.2) = (cell.1 + truth(p), cell.2 + 1.0);
             }
         }
     }
-    cells
+    cells.values().map(|(i, sum, n)| i / (sum / n)).collect()
+}
+
+/// The mean and the rms scatter about 1 of cell ratios.
+fn mean_and_scatter(ratios: &[f64]) -> (f64, f64) {
+    let n = ratios.len() as f64;
+    let mean = ratios.iter().sum::<f64>() / n;
+    let rms = (ratios.iter().map(|r| (r - 1.0).powi(2)).sum::<f64>() / n).sqrt();
+    (mean, rms)
+}
+
+/// What arrives anywhere in the furnace after 0…max_depth−1 bounces, times π (the
+/// cosine-weighted hemisphere): every cell's coupled irradiance.
+fn furnace_truth(albedo: f32, max_depth: u32) -> f64 {
+    let arriving: f64 = (0..max_depth as i32).map(|k| (albedo as f64).powi(k)).sum();
+    std::f64::consts::PI * arriving
+}
+
+/// The scatter (rms, relative) of the furnace's back-wall cells about `truth`, filled with 1
+/// sample per pixel of every view and `params`; their mean must be on it.
+fn furnace_scatter(
+    (h, albedo): (&Harness, f32),
+    s: &RenderSettings,
+    params: CacheParams,
+    what: &str,
+) -> f64 {
+    let truth = furnace_truth(albedo, s.path.max_depth);
+    let ratios = back_wall_ratios(&h.cache_with(s, 1, params), |_| truth);
+    let (mean, rms) = mean_and_scatter(&ratios);
+    let n = ratios.len();
+    eprintln!("{what}: {n} cells, mean {mean:.4} of the truth, rms {rms:.4}");
+    // The mean of hundreds of cells: its own noise is about 0.1 %.
+    assert!(n > 200, "{n} cells");
+    assert!(
+        (mean - 1.0).abs() < 0.005,
+        "{what}: mean {mean} of the truth"
+    );
+    rms
 }
 
 /// The later vertices of the fill paths (`render.fill_vertices`) estimate the same coupled
@@ -465,13 +502,8 @@ fn back_wall_cells(cache: &RadianceCache) -> Vec<f64> {
 /// since each holds more samples.
 #[test]
 fn later_fill_vertices_agree_with_the_furnace_and_cut_its_noise() {
-    let h = furnace();
+    let h = furnace(FURNACE_ALBEDO);
     let max_depth = 5u32;
-    // What arrives after 0…max_depth−1 bounces, times π (the cosine-weighted hemisphere).
-    let arriving: f64 = (0..max_depth as i32)
-        .map(|k| (FURNACE_ALBEDO as f64).powi(k))
-        .sum();
-    let truth = std::f64::consts::PI * arriving;
     for rr_depth in [max_depth + 1, 2] {
         let s = RenderSettings {
             path: lfgen::render::integrator::PathSettings {
@@ -485,22 +517,8 @@ fn later_fill_vertices_agree_with_the_furnace_and_cut_its_noise() {
                 fill_vertices,
                 ..common::CACHE
             };
-            let cells = back_wall_cells(&h.cache_with(&s, 1, params));
-            let n = cells.len() as f64;
-            let mean = cells.iter().sum::<f64>() / n;
-            let rms = (cells.iter().map(|i| (i / truth - 1.0).powi(2)).sum::<f64>() / n).sqrt();
-            eprintln!(
-                "rr_depth {rr_depth}, fill_vertices {fill_vertices}: {n} cells, mean {:.4} of \
-                 the truth, rms {rms:.4}",
-                mean / truth
-            );
-            // The mean of hundreds of cells: its own noise is about 0.1 %.
-            assert!(n > 200.0, "{n} cells");
-            assert!(
-                (mean / truth - 1.0).abs() < 0.005,
-                "rr_depth {rr_depth}, fill_vertices {fill_vertices}: mean {mean} vs {truth}"
-            );
-            rms
+            let what = format!("rr_depth {rr_depth}, fill_vertices {fill_vertices}");
+            furnace_scatter((&h, FURNACE_ALBEDO), &s, params, &what)
         };
         let (first, later) = (spread(1), spread(5));
         assert!(
@@ -508,4 +526,81 @@ fn later_fill_vertices_agree_with_the_furnace_and_cut_its_noise() {
             "rr_depth {rr_depth}: rms {later:.4} with later vertices vs {first:.4}"
         );
     }
+}
+
+/// Irradiance at `p` on the plane z = −3 (facing +Z) from a square light of side `side` and
+/// radiance `emission`, parallel to it at `centre` and facing it: π L times the form factor of
+/// the rectangle, the signed sum of four corner rectangles of the standard closed form
+/// (a differential area under one corner of a parallel `x × y` rectangle at height `c`).
+fn parallel_square_irradiance(p: Vec3, centre: Vec3, side: f64, emission: f64) -> f64 {
+    let c = (centre.z - p.z) as f64;
+    let corner = |x: f64, y: f64| {
+        let (x, y) = (x / c, y / c);
+        let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
+        (x / sx * (y / sx).atan() + y / sy * (x / sy).atan()) / (2.0 * std::f64::consts::PI)
+    };
+    let (dx, dy) = ((centre.x - p.x) as f64, (centre.y - p.y) as f64);
+    let (x1, x2, y1, y2) = (
+        dx - side / 2.0,
+        dx + side / 2.0,
+        dy - side / 2.0,
+        dy + side / 2.0,
+    );
+    let form = corner(x2, y2) - corner(x1, y2) - corner(x2, y1) + corner(x1, y1);
+    std::f64::consts::PI * emission * form
+}
+
+/// More light samples at a fill path's first vertex (`render.fill_light_samples`) average
+/// copies of the same MIS-weighted estimator. A black wall lit by two small lights at
+/// different distances: each cell's coupled irradiance is the closed-form irradiance of the
+/// two squares, all of it direct; one light sample picks one light (by power over distance)
+/// and carries nearly all of it, so its choice and point are the cells' noise. With eight the
+/// cells stay on the closed form and scatter less than half as much.
+#[test]
+fn more_fill_light_samples_stay_on_the_closed_form_and_cut_its_noise() {
+    let cam = camera([64, 64], [3, 3], 35.0, DVec3::new(0.0, 1.5, 2.0));
+    let black = Material {
+        model: SurfaceModel::Diffuse,
+        ..matte([0.0; 3], 1.0)
+    };
+    let (side, emission) = (0.4, 20.0);
+    let centres = [Vec3::new(-1.0, 1.0, -1.0), Vec3::new(1.2, 2.0, -0.4)];
+    let light = |centre| {
+        let mut light = quad([side as f32; 2], centre, emitter([emission as f32; 3]));
+        light.transform.rotation = Quat::from_rotation_y(std::f32::consts::PI);
+        light
+    };
+    let wall = quad([8.0, 6.0], Vec3::new(0.0, 1.5, -3.0), black);
+    let parts = vec![wall, light(centres[0]), light(centres[1])];
+    let h = Harness::new(scene(cam, [1.0, 5.2], [0.0; 3], parts));
+    let s = settings(1, 5);
+    let truth = |p: Vec3| {
+        (centres.iter())
+            .map(|&c| parallel_square_irradiance(p, c, side, emission))
+            .sum::<f64>()
+    };
+    let spread = |fill_light_samples| {
+        let params = CacheParams {
+            fill_vertices: 1,
+            fill_light_samples,
+            ..common::CACHE
+        };
+        let ratios = back_wall_ratios(&h.cache_with(&s, 1, params), truth);
+        let (mean, rms) = mean_and_scatter(&ratios);
+        let n = ratios.len();
+        eprintln!(
+            "fill_light_samples {fill_light_samples}: {n} cells, mean {mean:.4} of the closed \
+             form, rms {rms:.4}"
+        );
+        assert!(n > 200, "{n} cells");
+        (mean, rms)
+    };
+    let ((mean_one, one), (mean_eight, eight)) = (spread(1), spread(8));
+    for mean in [mean_one, mean_eight] {
+        assert!((mean - 1.0).abs() < 0.01, "mean {mean}");
+    }
+    assert!(
+        eight < 0.5 * one,
+        "rms {eight:.4} with 8 light samples vs {one:.4}"
+    );
 }

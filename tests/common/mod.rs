@@ -46,6 +46,7 @@ pub const CACHE: CacheParams = CacheParams {
     cell_px: 1.0,
     glossy_share: 4.0,
     fill_vertices: 5,
+    fill_light_samples: 1,
 };
 
 /// Focal length in pixels, from docs/conventions.md, Camera (not from the code under test).

@@ -55,6 +55,9 @@ pub struct CacheParams {
     /// first (the camera's) alone; more adds those of its later surface vertices, up to
     /// [`MAX_FILL_VERTICES`] (see [`CacheSums::add_later`]).
     pub fill_vertices: u32,
+    /// Light samples a fill path takes at its first vertex (see
+    /// [`CacheGrid::fill_light_samples`]).
+    pub fill_light_samples: u32,
 }
 
 /// The most vertices of one fill path that feed the cache.
@@ -71,6 +74,11 @@ pub struct CacheGrid {
     shared_lobe_span: f64,
     /// [`CacheParams::fill_vertices`].
     pub fill_vertices: u32,
+    /// Light samples at a fill path's first vertex, averaged. The cell's estimate there is
+    /// the whole of what a Lambert surface shows, and with many lamps one light sample is much
+    /// of its noise (it picks a lamp by power over distance, blind to whether it is hidden);
+    /// a shadow ray costs a fraction of the path behind it.
+    pub fill_light_samples: u32,
 }
 
 impl CacheGrid {
@@ -83,6 +91,7 @@ impl CacheGrid {
             cell_per_depth: params.cell_px as f64 / cam.f_px(),
             shared_lobe_span: params.glossy_share as f64 * gx.hypot(gy) * cam.baseline_m,
             fill_vertices: params.fill_vertices.clamp(1, MAX_FILL_VERTICES),
+            fill_light_samples: params.fill_light_samples.max(1),
         }
     }
 
@@ -516,6 +525,7 @@ mod tests {
         cell_px: 1.0,
         glossy_share: 4.0,
         fill_vertices: 1,
+        fill_light_samples: 1,
     };
 
     #[test]

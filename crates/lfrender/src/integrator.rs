@@ -345,6 +345,8 @@ impl RenderScene {
             // Probability that this vertex continues by BSDF sampling (below 1 only for the
             // glossy lobe of a cached vertex): the BSDF strategy's pdf for MIS is scaled by it.
             let mut select = 1.0;
+            // Light samples this vertex averages (more only at a fill path's first vertex).
+            let mut light_samples = 1;
             // A later vertex of a fill path that estimates its coupled irradiance too.
             let opens = own
                 && fill.is_some()
@@ -363,6 +365,7 @@ impl RenderScene {
                         let cells = grid.keys(p, frame.n, s.material);
                         fill = Some((cells, glossy));
                         first_depth = depth;
+                        light_samples = grid.fill_light_samples;
                         (radiance, beta, lobes) = match glossy {
                             true => {
                                 let albedo = bsdf.specular_albedo(wo_l);
@@ -408,7 +411,20 @@ impl RenderScene {
             let mut direct = Vec3::ZERO;
             if !bsdf.is_delta() && !self.lights.is_empty() {
                 let strategy = (lobes, select);
-                let (l, coupled) = self.direct_light(&vertex, strategy, opens, sampler);
+                let (mut l, mut coupled) = self.direct_light(&vertex, strategy, opens, sampler);
+                if light_samples > 1 {
+                    // The others from a side sequence of their own, stratified among
+                    // themselves. Each is the same MIS-weighted estimator, so their mean keeps
+                    // the weights' sum with the BSDF sample at one.
+                    let mut side = sampler.side(depth);
+                    for k in 1..light_samples {
+                        side.start_sample(k);
+                        let (a, b) = self.direct_light(&vertex, strategy, opens, &mut side);
+                        (l, coupled) = (l + a, coupled + b);
+                    }
+                    let n = light_samples as f32;
+                    (l, coupled) = (l / n, coupled / n);
+                }
                 if own {
                     radiance += beta * l;
                 }

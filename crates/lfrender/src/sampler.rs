@@ -112,6 +112,12 @@ impl Sampler {
         self.values[within as usize]
     }
 
+    /// An independent sequence for extra samples of this sample's vertex `depth` (its light
+    /// samples beyond the first): keyed by the pixel, the sample and the vertex.
+    pub fn side(&self, depth: u32) -> Sampler {
+        Self::from_key(mix64(self.seed ^ (self.index as u64) << 32 ^ depth as u64))
+    }
+
     /// The next dimension to be drawn, for [`Self::resume_at`].
     #[inline]
     pub fn dimension(&self) -> u32 {
