@@ -418,17 +418,17 @@ fn adaptive_sampling_refines_the_noisy_pixels() {
     assert!(after < 0.5 * before, "MSE {before:.2e} → {after:.2e}");
 }
 
-/// A furnace: a closed Lambert room of albedo `albedo` whose every wall also emits radiance 1.
-/// Light arriving anywhere from any direction is then known in closed form (the emission after
-/// 0, 1, … bounces), and so is every cell's coupled irradiance.
+/// A furnace: a closed Lambert room of albedo `FURNACE_ALBEDO` whose every wall also emits
+/// radiance 1. Light arriving anywhere from any direction is then known in closed form (the
+/// emission after 0, 1, … bounces), and so is every cell's coupled irradiance.
 const FURNACE_ALBEDO: f32 = 0.5;
 
-fn furnace(albedo: f32) -> Harness {
+fn furnace() -> Harness {
     let cam = camera([64, 64], [5, 5], 35.0, DVec3::new(0.0, 1.5, 2.0));
     let walls = Material {
         model: SurfaceModel::Diffuse,
         emission: [1.0; 3],
-        ..matte([albedo; 3], 1.0)
+        ..matte([FURNACE_ALBEDO; 3], 1.0)
     };
     let room = Part {
         shape: Shape::Room {
@@ -468,20 +468,17 @@ fn mean_and_scatter(ratios: &[f64]) -> (f64, f64) {
 
 /// What arrives anywhere in the furnace after 0…max_depth−1 bounces, times π (the
 /// cosine-weighted hemisphere): every cell's coupled irradiance.
-fn furnace_truth(albedo: f32, max_depth: u32) -> f64 {
-    let arriving: f64 = (0..max_depth as i32).map(|k| (albedo as f64).powi(k)).sum();
+fn furnace_truth(max_depth: u32) -> f64 {
+    let arriving: f64 = (0..max_depth as i32)
+        .map(|k| (FURNACE_ALBEDO as f64).powi(k))
+        .sum();
     std::f64::consts::PI * arriving
 }
 
 /// The scatter (rms, relative) of the furnace's back-wall cells about `truth`, filled with 1
 /// sample per pixel of every view and `params`; their mean must be on it.
-fn furnace_scatter(
-    (h, albedo): (&Harness, f32),
-    s: &RenderSettings,
-    params: CacheParams,
-    what: &str,
-) -> f64 {
-    let truth = furnace_truth(albedo, s.path.max_depth);
+fn furnace_scatter(h: &Harness, s: &RenderSettings, params: CacheParams, what: &str) -> f64 {
+    let truth = furnace_truth(s.path.max_depth);
     let ratios = back_wall_ratios(&h.cache_with(s, 1, params), |_| truth);
     let (mean, rms) = mean_and_scatter(&ratios);
     let n = ratios.len();
@@ -502,7 +499,7 @@ fn furnace_scatter(
 /// since each holds more samples.
 #[test]
 fn later_fill_vertices_agree_with_the_furnace_and_cut_its_noise() {
-    let h = furnace(FURNACE_ALBEDO);
+    let h = furnace();
     let max_depth = 5u32;
     for rr_depth in [max_depth + 1, 2] {
         let s = RenderSettings {
@@ -518,7 +515,7 @@ fn later_fill_vertices_agree_with_the_furnace_and_cut_its_noise() {
                 ..common::CACHE
             };
             let what = format!("rr_depth {rr_depth}, fill_vertices {fill_vertices}");
-            furnace_scatter((&h, FURNACE_ALBEDO), &s, params, &what)
+            furnace_scatter(&h, &s, params, &what)
         };
         let (first, later) = (spread(1), spread(5));
         assert!(
@@ -559,10 +556,6 @@ fn parallel_square_irradiance(p: Vec3, centre: Vec3, side: f64, emission: f64) -
 #[test]
 fn more_fill_light_samples_stay_on_the_closed_form_and_cut_its_noise() {
     let cam = camera([64, 64], [3, 3], 35.0, DVec3::new(0.0, 1.5, 2.0));
-    let black = Material {
-        model: SurfaceModel::Diffuse,
-        ..matte([0.0; 3], 1.0)
-    };
     let (side, emission) = (0.4, 20.0);
     let centres = [Vec3::new(-1.0, 1.0, -1.0), Vec3::new(1.2, 2.0, -0.4)];
     let light = |centre| {
@@ -570,7 +563,11 @@ fn more_fill_light_samples_stay_on_the_closed_form_and_cut_its_noise() {
         light.transform.rotation = Quat::from_rotation_y(std::f32::consts::PI);
         light
     };
-    let wall = quad([8.0, 6.0], Vec3::new(0.0, 1.5, -3.0), black);
+    let wall = quad(
+        [8.0, 6.0],
+        Vec3::new(0.0, 1.5, -3.0),
+        black(matte([0.0; 3], 1.0)),
+    );
     let parts = vec![wall, light(centres[0]), light(centres[1])];
     let h = Harness::new(scene(cam, [1.0, 5.2], [0.0; 3], parts));
     let s = settings(1, 5);

@@ -462,12 +462,12 @@ impl RenderScene {
             }
             let mut f = bs.f * bs.wi.z.abs() / bs.pdf;
             if split && bs.pdf < 1.0 {
-                // Refraction was sampled with probability `pdf = 1 − F`: both branches now
-                // carry their Fresnel weight instead of being chosen with it.
+                // Refraction was sampled with probability `pdf = 1 − F`; split, both branches
+                // carry their throughput `f cos` instead of being chosen with their pdf.
                 f *= bs.pdf;
                 let length = camera_length.unwrap_or(0.0);
-                let reflected = self.reflection(settings, &vertex, depth, length, sampler, shading);
-                radiance += beta * (1.0 - bs.pdf) * reflected;
+                radiance +=
+                    beta * self.reflection(settings, &vertex, depth, length, sampler, shading);
             }
             beta *= f;
             later.scale(f);
@@ -523,8 +523,8 @@ impl RenderScene {
         }
     }
 
-    /// Radiance the mirror reflection at glass `v` (loop depth `depth`, camera ray `length`
-    /// long so far) brings back: the branch of a split camera path. Choosing reflection with
+    /// Light the mirror reflection at glass `v` (loop depth `depth`, camera ray `length` long
+    /// so far) brings back, times its throughput `F`: the branch of a split camera path. Choosing reflection with
     /// probability F, as the path does elsewhere, leaves the pixel to average how many of its
     /// samples took it; under a bright reflection (a window in a glass table) that count is
     /// most of the pixel's noise at 16 spp, and each view counts its own. Tracing both costs
@@ -540,9 +540,12 @@ impl RenderScene {
         sampler: &mut Sampler,
         shading: Shading,
     ) -> Vec3 {
+        // The glass BSDF's own reflection: `u_lobe = 0` lies below any F > 0.
+        let Some(r) = v.bsdf.sample(v.wo_l, 0.0, Vec2::ZERO) else {
+            return Vec3::ZERO;
+        };
         let resume = sampler.dimension();
-        let wi = Vec3::new(-v.wo_l.x, -v.wo_l.y, v.wo_l.z);
-        let dir = v.frame.to_world(wi);
+        let dir = v.frame.to_world(r.wi);
         let origin = self.spawn(v.p, v.hit.tri, dir);
         let key = sampler.next_key();
         let first = (self.geometry).closest(&self.materials, origin, dir, f32::INFINITY, key);
@@ -556,7 +559,7 @@ impl RenderScene {
         };
         let traced = self.trace_from(settings, start, sampler, shading);
         sampler.resume_at(resume);
-        traced.radiance
+        r.f * r.wi.z.abs() * traced.radiance
     }
 
     /// Whether a fill sample estimates the shared glossy term at its first vertex (else the
