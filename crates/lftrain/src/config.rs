@@ -782,6 +782,25 @@ mod tests {
         );
     }
 
+    /// The GPU check's config is the thesis' recipe (the defaults) at batch 64 for 200 steps:
+    /// only the batch and the run's bookkeeping differ, so its timings are the thesis net's.
+    #[test]
+    fn the_gpu_check_config_is_the_thesis_recipe_at_batch_64() {
+        let gpu: TrainConfig = toml::from_str(include_str!("../configs/gpu_thesis.toml")).unwrap();
+        gpu.validate().unwrap();
+        assert_eq!(
+            gpu,
+            TrainConfig {
+                batch: 64,
+                steps: 200,
+                checkpoint_every: 100,
+                val_every: 1000,
+                ..TrainConfig::default()
+            }
+        );
+        assert!(gpu.batch * gpu.patch * gpu.patch <= MAX_BATCH_PIXELS);
+    }
+
     #[test]
     fn ese_passes_are_symmetric_by_default_or_span_a_range() {
         let ese = EseConfig::default();

@@ -202,12 +202,13 @@ fn run(cli: Cli) -> Result<()> {
             }
             let (s, params) = bench_steps(&cfg, grid, steps)?;
             println!(
-                "{} ({params} parameter values incl. batch-norm statistics): batch {} of {}x{} patches, {grid}x{grid} views: \
-                 {s:.3} s per step ({:.1} samples/s)",
+                "{} ({params} parameter values incl. batch-norm statistics): batch {} of {}x{} patches, {grid}x{grid} views, \
+                 on {:?}: {s:.3} s per step ({:.1} samples/s)",
                 cfg.model.name(),
                 cfg.batch,
                 cfg.patch,
                 cfg.patch,
+                lftrain::train::default_device(),
                 cfg.batch as f64 / s
             );
         }

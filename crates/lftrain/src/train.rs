@@ -106,6 +106,10 @@ pub fn train(mut cfg: TrainConfig, args: &TrainArgs) -> Result<TrainSummary> {
         None => Vec::new(),
     };
     let base = default_device();
+    if !args.quiet {
+        // Names the backend, so a GPU build that fell back or picked another adapter shows.
+        eprintln!("lftrain: training on {base:?}");
+    }
     let device = base.clone().autodiff();
     base.seed(cfg.seed);
     let (net, optim) = if args.resume {
