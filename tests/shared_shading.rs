@@ -525,6 +525,25 @@ fn later_fill_vertices_agree_with_the_furnace_and_cut_its_noise() {
     }
 }
 
+/// The defaults together: later fill vertices (`fill_vertices = 5`) and four light samples
+/// where the fill starts, each tested above only with the other at 1. In the furnace (its
+/// emitting walls are the lights those samples pick) the cells stay on the closed form with
+/// both — the first vertex's average divided wrongly would move every cell, its own estimate
+/// and the later ones that share its light.
+#[test]
+fn later_fill_vertices_and_more_light_samples_together_stay_on_the_furnace() {
+    let h = furnace();
+    let s = settings(1, 5);
+    for fill_light_samples in [1, 4] {
+        let params = CacheParams {
+            fill_light_samples,
+            ..common::CACHE
+        };
+        let what = format!("fill_vertices 5, fill_light_samples {fill_light_samples}");
+        furnace_scatter(&h, &s, params, &what);
+    }
+}
+
 /// Irradiance at `p` on the plane z = −3 (facing +Z) from a square light of side `side` and
 /// radiance `emission`, parallel to it at `centre` and facing it: π L times the form factor of
 /// the rectangle, the signed sum of four corner rectangles of the standard closed form
