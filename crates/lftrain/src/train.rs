@@ -107,7 +107,7 @@ pub fn train(mut cfg: TrainConfig, args: &TrainArgs) -> Result<TrainSummary> {
     };
     let base = default_device();
     if !args.quiet {
-        // Names the backend, so a GPU build that fell back or picked another adapter shows.
+        // Names the backend: a wgpu build runs where BURN_DEVICE (or the first adapter) says.
         eprintln!("lftrain: training on {base:?}");
     }
     let device = base.clone().autodiff();
