@@ -9,7 +9,8 @@ A scene keeps only what `lftrain train`/`predict` read: parameters.cfg, gt_disp_
 modes.exr and the 33 star views. The views travel as lossless WebP (about 30 % smaller than
 lfgen's PNGs, pixel-identical after unpacking) and the stripped binary as xz (the wgpu build is
 ~100 MB stripped, ~17 MB packed). A 256² scene then takes ~4.5 MB. No manifest travels, so
-lfformat does not check the pruned scenes against the dataset's checksums.
+lfformat does not check the pruned scenes against the dataset's checksums. Needs Python 3 and
+Pillow (WebP support) on both machines.
 """
 import argparse
 import lzma
