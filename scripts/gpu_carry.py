@@ -26,7 +26,8 @@ TRUTH = ("parameters.cfg", "gt_disp_lowres.pfm", "modes.exr")
 
 
 def star(n):
-    """View indices of the star (row, column and both diagonals) of an n×n grid."""
+    """View indices of the star (row, column and both diagonals) of an n×n grid: the views
+    lftrain reads, as lfformat's `ViewSet::Star` defines them."""
     c = n // 2
     return [v * n + u for v in range(n) for u in range(n)
             if u == c or v == c or abs(u - c) == abs(v - c)]

@@ -524,13 +524,14 @@ impl RenderScene {
     }
 
     /// Light the mirror reflection at glass `v` (loop depth `depth`, camera ray `length` long
-    /// so far) brings back, times its throughput `F`: the branch of a split camera path. Choosing reflection with
-    /// probability F, as the path does elsewhere, leaves the pixel to average how many of its
-    /// samples took it; under a bright reflection (a window in a glass table) that count is
-    /// most of the pixel's noise at 16 spp, and each view counts its own. Tracing both costs
-    /// one ray and mostly one cache lookup. The branch continues at the depth the chosen
-    /// reflection would have, splits no further, and draws from the dimensions of its own
-    /// depths: the pixel's sequence resumes where it was for the path's own decisions.
+    /// so far) brings back, times its throughput `F`: the branch of a split camera path.
+    /// Choosing reflection with probability F, as the path does elsewhere, leaves the pixel
+    /// to average how many of its samples took it; under a bright reflection (a window in a
+    /// glass table) that count is most of the pixel's noise at 16 spp, and each view counts
+    /// its own. Tracing both costs one ray and mostly one cache lookup. The branch continues
+    /// at the depth the chosen reflection would have, splits no further, and draws from the
+    /// dimensions of its own depths: the pixel's sequence resumes where it was for the path's
+    /// own decisions.
     fn reflection(
         &self,
         settings: &PathSettings,
