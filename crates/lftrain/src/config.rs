@@ -504,6 +504,12 @@ pub struct TrainConfig {
     pub dpp: DppConfig,
     /// EPI-Shift settings.
     pub epishift: EpiShiftConfig,
+    /// Test-time rotations of BASE, UPR, ESE and DPP (not in the thesis): `lftrain predict`
+    /// averages the network's output planes over the light field turned by the first this
+    /// many quarter turns (1: off; 4: all), each turned back. A net trained with
+    /// `augment.rotate` has seen every turn, so each is an equally good estimate whose
+    /// errors are partly independent. `lftrain predict --rotations` overrides it.
+    pub test_rotations: usize,
 }
 
 impl Default for TrainConfig {
@@ -537,6 +543,7 @@ impl Default for TrainConfig {
             ese: EseConfig::default(),
             dpp: DppConfig::default(),
             epishift: EpiShiftConfig::default(),
+            test_rotations: 1,
         }
     }
 }
@@ -592,6 +599,15 @@ impl TrainConfig {
         }
         if self.dpp.bins < 2 || self.dpp.max <= self.dpp.min {
             bail!("dpp needs ≥ 2 bins over a non-empty range");
+        }
+        if !(1..=4).contains(&self.test_rotations) {
+            bail!(
+                "test_rotations must be 1 to 4 quarter turns, got {}",
+                self.test_rotations
+            );
+        }
+        if self.model == ModelKind::EpiShift && self.test_rotations != 1 {
+            bail!("test_rotations applies to base, upr, ese and dpp; epishift takes 1");
         }
         if self.ese.members == 0 || self.ese.members.is_multiple_of(2) || self.ese.delta <= 0.0 {
             bail!("ese.members must be odd and ese.delta positive");
@@ -899,5 +915,23 @@ mod tests {
                 .unwrap_err()
                 .contains("pixels")
         );
+    }
+
+    #[test]
+    fn test_rotations_are_one_to_four_turns_and_not_for_epishift() {
+        let with = |text: &str| {
+            let cfg: TrainConfig = toml::from_str(text).unwrap();
+            cfg.validate().map_err(|e| e.to_string())
+        };
+        assert_eq!(TrainConfig::default().test_rotations, 1);
+        assert!(with("test_rotations = 4\nmodel = \"dpp\"").is_ok());
+        assert!(
+            with("test_rotations = 0")
+                .unwrap_err()
+                .contains("test_rotations")
+        );
+        assert!(with("test_rotations = 5").unwrap_err().contains("1 to 4"));
+        let epishift = "model = \"epishift\"\npatch = 64\ntest_rotations = 4";
+        assert!(with(epishift).unwrap_err().contains("epishift takes 1"));
     }
 }

@@ -7,7 +7,7 @@ use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
 use lftrain::config::{ModelKind, TrainConfig};
 use lftrain::loader::PoolConfig;
-use lftrain::predict::predict_dataset_over;
+use lftrain::predict::{Overrides, predict_dataset_over};
 use lftrain::train::{TrainArgs, bench_loader, bench_steps, train};
 
 /// Training allocates and frees every activation and gradient tensor each step. With glibc's
@@ -55,6 +55,10 @@ enum Command {
         /// epishift.coarse_max; 0: off).
         #[arg(long, value_name = "PX")]
         coarse_max: Option<f32>,
+        /// Average BASE, UPR, ESE and DPP over the light field turned by the first N quarter
+        /// turns, 1 to 4 (overrides the run's test_rotations; 1: off).
+        #[arg(long, value_name = "N")]
+        rotations: Option<usize>,
     },
     /// Seconds per training step of a configuration on random input (no data loading), or
     /// with --loader the crops/s of the data loader alone.
@@ -218,8 +222,14 @@ fn run(cli: Cli) -> Result<()> {
             out,
             range,
             coarse_max,
+            rotations,
         } => {
-            let n = predict_dataset_over(&run, &dataset, &out, cli.quiet, range, coarse_max)?;
+            let overrides = Overrides {
+                range,
+                coarse_max,
+                rotations,
+            };
+            let n = predict_dataset_over(&run, &dataset, &out, cli.quiet, &overrides)?;
             eprintln!("lftrain: {n} scenes written to {}", out.display());
         }
     }

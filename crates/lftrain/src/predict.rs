@@ -12,17 +12,41 @@ use lfformat::pfm::FloatImage;
 
 use crate::config::{ModelKind, TrainConfig};
 use crate::epishift::EpiShiftNet;
-use crate::lightfield::LightField;
+use crate::lightfield::{LightField, rotate_plane};
 use crate::model::{EpiNet, Network};
 use crate::shift_predict::estimate;
 use crate::stacks::{Direction, Region, extract};
 use crate::tensors::{tensor4, values};
 
-/// Raw network outputs `[C][H·W]` (channel planes) for `lf` EPI-shifted by `shift`.
+/// Raw network outputs `[C][H·W]` (channel planes) for `lf` EPI-shifted by `shift`, averaged
+/// over `lf` turned by `0 .. rotations` quarter turns (each output turned back; see
+/// [`TrainConfig::test_rotations`]).
 ///
 /// `net` must be in validation mode on a device without autodiff (batch norm then uses its
 /// running statistics).
-pub fn run_net(net: &EpiNet, lf: &LightField, shift: f32, device: &Device) -> Vec<Vec<f32>> {
+pub fn run_net(
+    net: &EpiNet,
+    lf: &LightField,
+    shift: f32,
+    rotations: usize,
+    device: &Device,
+) -> Vec<Vec<f32>> {
+    let mut sum = run_once(net, lf, shift, device);
+    for turns in 1..rotations {
+        let turned = lf.rotate(turns);
+        let planes = run_once(net, &turned, shift, device);
+        for (total, plane) in sum.iter_mut().zip(planes) {
+            let back = turn_plane(plane, turned.width, turned.height, 4 - turns);
+            total.iter_mut().zip(back).for_each(|(t, v)| *t += v);
+        }
+    }
+    let scale = 1.0 / rotations as f32;
+    sum.iter_mut().flatten().for_each(|v| *v *= scale);
+    sum
+}
+
+/// The network's output planes for `lf` as it is.
+fn run_once(net: &EpiNet, lf: &LightField, shift: f32, device: &Device) -> Vec<Vec<f32>> {
     let region = Region::whole(lf);
     let shape = [1, lf.n * 3, lf.height, lf.width];
     let stacks = Direction::ALL.map(|dir| tensor4(extract(lf, dir, region, shift), shape, device));
@@ -30,6 +54,15 @@ pub fn run_net(net: &EpiNet, lf: &LightField, shift: f32, device: &Device) -> Ve
     out.chunks_exact(lf.width * lf.height)
         .map(<[f32]>::to_vec)
         .collect()
+}
+
+/// A `w × h` plane turned by `turns` quarter turns (as [`LightField::rotate`] turns views).
+fn turn_plane(plane: Vec<f32>, w: usize, h: usize, turns: usize) -> Vec<f32> {
+    (0..turns % 4)
+        .fold((plane, w, h), |(p, w, h), _| {
+            (rotate_plane(&p, w, h, 1), h, w)
+        })
+        .0
 }
 
 /// The prediction of `net` (trained as `cfg.model`) for `lf`, with its runtime.
@@ -78,18 +111,21 @@ fn predict_epinet(
     let posterior = match cfg.model {
         ModelKind::Base => None,
         ModelKind::Upr => {
-            let mut out = run_net(net, lf, 0.0, device);
+            let mut out = run_net(net, lf, 0.0, cfg.test_rotations, device);
             let log_b = out.swap_remove(1);
             let mu = out.swap_remove(0);
             Some(PosteriorForm::Laplace { mu, log_b })
         }
         ModelKind::Ese => Some(ese_mixture(cfg, net, lf, device)),
-        ModelKind::Dpp => Some(dpp_posterior(cfg, run_net(net, lf, 0.0, device))),
+        ModelKind::Dpp => Some(dpp_posterior(
+            cfg,
+            run_net(net, lf, 0.0, cfg.test_rotations, device),
+        )),
         ModelKind::EpiShift => unreachable!("EPI-Shift runs its own network"),
     };
     let (disparity, posterior) = match posterior {
         None => {
-            let out = run_net(net, lf, 0.0, device);
+            let out = run_net(net, lf, 0.0, cfg.test_rotations, device);
             (FloatImage::new(w, h, out[0].clone()), None)
         }
         Some(form) => {
@@ -117,7 +153,7 @@ fn ese_mixture(cfg: &TrainConfig, net: &EpiNet, lf: &LightField, device: &Device
     let pixels = lf.width * lf.height;
     let (mut mu, mut log_b) = (vec![0.0; pixels * m], vec![0.0; pixels * m]);
     for (k, &s) in shifts.iter().enumerate() {
-        let out = run_net(net, lf, s, device);
+        let out = run_net(net, lf, s, cfg.test_rotations, device);
         for i in 0..pixels {
             mu[i * m + k] = out[0][i] + s;
             log_b[i * m + k] = out[1][i];
@@ -161,45 +197,62 @@ pub fn predict_dataset(
     out: &std::path::Path,
     quiet: bool,
 ) -> anyhow::Result<usize> {
-    predict_dataset_over(run, dataset, out, quiet, None, None)
+    predict_dataset_over(run, dataset, out, quiet, &Overrides::default())
 }
 
-/// [`predict_dataset`] with the disparity range of the shifts given (`--range`): EPI-Shift's
-/// integer shifts, or ESE's passes at its step, then cover `range` instead of what the run's
-/// config (EPI-Shift: each scene's `parameters.cfg`) says.
+/// What `lftrain predict`'s flags change in a run's config.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Overrides {
+    /// `--range`: EPI-Shift's integer shifts, or ESE's passes at its step, cover this range
+    /// instead of what the run's config (EPI-Shift: each scene's `parameters.cfg`) says.
+    pub range: Option<[f32; 2]>,
+    /// `--coarse-max`: [`crate::config::EpiShiftConfig::coarse_max`].
+    pub coarse_max: Option<f32>,
+    /// `--rotations`: [`TrainConfig::test_rotations`].
+    pub rotations: Option<usize>,
+}
+
+impl Overrides {
+    /// `cfg` with these overrides, refused where they do not apply to its model or are out
+    /// of range (the error names the flag).
+    fn apply(&self, mut cfg: TrainConfig) -> anyhow::Result<TrainConfig> {
+        let name = cfg.model.name();
+        if let Some(c) = self.coarse_max {
+            if cfg.model != ModelKind::EpiShift {
+                anyhow::bail!("--coarse-max applies to epishift runs, this is {name}");
+            }
+            cfg.epishift.coarse_max = c;
+            cfg.validate()
+                .map_err(|e| e.context(format!("--coarse-max {c}")))?;
+        }
+        if let Some(r) = self.range {
+            match cfg.model {
+                ModelKind::EpiShift => cfg.epishift.range = Some(r),
+                ModelKind::Ese => cfg.ese.range = Some(r),
+                _ => anyhow::bail!("--range applies to epishift and ese runs, this is {name}"),
+            }
+            cfg.validate()
+                .map_err(|e| e.context(format!("--range {},{}", r[0], r[1])))?;
+        }
+        if let Some(k) = self.rotations {
+            cfg.test_rotations = k;
+            cfg.validate()
+                .map_err(|e| e.context(format!("--rotations {k}")))?;
+        }
+        Ok(cfg)
+    }
+}
+
+/// [`predict_dataset`] with the run's config changed by `overrides`.
 pub fn predict_dataset_over(
     run: &std::path::Path,
     dataset: &std::path::Path,
     out: &std::path::Path,
     quiet: bool,
-    range: Option<[f32; 2]>,
-    coarse_max: Option<f32>,
+    overrides: &Overrides,
 ) -> anyhow::Result<usize> {
     let run = crate::run::RunDir::new(run);
-    let mut cfg = run.config()?;
-    if let Some(c) = coarse_max {
-        if cfg.model != ModelKind::EpiShift {
-            anyhow::bail!(
-                "--coarse-max applies to epishift runs, this is {}",
-                cfg.model.name()
-            );
-        }
-        cfg.epishift.coarse_max = c;
-        cfg.validate()
-            .map_err(|e| e.context(format!("--coarse-max {c}")))?;
-    }
-    if let Some(r) = range {
-        match cfg.model {
-            ModelKind::EpiShift => cfg.epishift.range = Some(r),
-            ModelKind::Ese => cfg.ese.range = Some(r),
-            m => anyhow::bail!(
-                "--range applies to epishift and ese runs, this is {}",
-                m.name()
-            ),
-        }
-        cfg.validate()
-            .map_err(|e| e.context(format!("--range {},{}", r[0], r[1])))?;
-    }
+    let cfg = overrides.apply(run.config()?)?;
     let state = run.state()?;
     let device = crate::train::default_device();
     let net = run.load_net(&cfg, state.grid, &device)?.valid();

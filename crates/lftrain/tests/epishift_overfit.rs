@@ -85,8 +85,11 @@ fn tiny_epishift_overfits_a_tiny_dataset_then_predicts_far_disparities() {
     let pred = tmp.path().join("pred_far");
     lftrain::predict::predict_dataset(&run, &far, &pred, true).unwrap();
     let narrow = tmp.path().join("pred_narrow");
-    lftrain::predict::predict_dataset_over(&run, &far, &narrow, true, Some([-1.1, 1.4]), None)
-        .unwrap();
+    let range = lftrain::predict::Overrides {
+        range: Some([-1.1, 1.4]),
+        ..Default::default()
+    };
+    lftrain::predict::predict_dataset_over(&run, &far, &narrow, true, &range).unwrap();
     let score = |p: &std::path::Path| {
         let m = lfeval::prediction::Method::new(p).unwrap();
         let d = m.load("a", 24, 24).unwrap().disparity;

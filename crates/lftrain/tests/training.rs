@@ -386,3 +386,48 @@ fn a_patch_larger_than_the_scenes_is_refused_naming_the_scene() {
         "{err}"
     );
 }
+
+#[test]
+fn test_rotations_turn_the_prediction_with_the_light_field() {
+    use lftrain::lightfield::{LightField, rotate_plane};
+    use lftrain::predict::run_net;
+    let dev = device();
+    dev.seed(9);
+    // Eight output planes: an untrained net's ReLU before the last convolution leaves some
+    // of them constant, which would pass any check.
+    let net = EpiNet::new(&tiny_net(), 9, 8, &dev);
+    // A non-square light field, so a width/height mix-up cannot pass.
+    let (w, h) = (12, 8);
+    let lf = LightField::from_fn(3, w, h, |u, v, x, y| {
+        let t = (x * 7 + y * 13 + u * 3 + v * 5) as f32;
+        [
+            t.sin().abs(),
+            (0.7 * t).cos().abs(),
+            ((x ^ y) % 3) as f32 / 2.0,
+        ]
+    });
+    let turned = lf.rotate(1);
+    // The largest |difference| between the output for the turned light field and the
+    // turned output, and the largest spread of an output plane.
+    let gap_and_spread = |rotations: usize| {
+        let plain = run_net(&net, &lf, 0.0, rotations, &dev);
+        let of_turned = run_net(&net, &turned, 0.0, rotations, &dev);
+        let (mut gap, mut spread) = (0.0f32, 0.0f32);
+        for (p, t) in plain.iter().zip(&of_turned) {
+            let expected = rotate_plane(p, w, h, 1);
+            assert_eq!(t.len(), expected.len());
+            (t.iter().zip(&expected)).for_each(|(a, b)| gap = gap.max((a - b).abs()));
+            p.iter().for_each(|v| spread = spread.max((v - p[0]).abs()));
+        }
+        (gap, spread)
+    };
+    let (gap, spread) = gap_and_spread(4);
+    assert!(spread > 1e-2, "the outputs are flat: {spread}");
+    // Averaged over the four turns, turning the input turns the output: exactly, but for
+    // the order of the float sums.
+    assert!(gap < 1e-5 * spread, "{gap} of {spread}");
+    // One turn alone is no such average (2×2 convolutions and the head's fixed stream order
+    // make the net itself not rotation-equivariant), so the check above could fail.
+    let (gap, spread) = gap_and_spread(1);
+    assert!(gap > 1e-2 * spread, "{gap} of {spread}");
+}
