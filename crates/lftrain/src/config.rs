@@ -255,6 +255,13 @@ pub struct DppConfig {
     pub min: f32,
     /// Upper edge of the last bin, pixels.
     pub max: f32,
+    /// The point estimate (the disparity map lfeval scores MSE and BadPix on). 0: the most
+    /// probable bin's centre (the thesis, mmlf). `r > 0`: the `2r + 1` neighbouring bins with
+    /// the most probability together, and the mean of their centres weighted by it — the
+    /// most likely mode at a scale of `2r + 1` bins instead of one (not in the thesis). An
+    /// under-trained net's posterior has single-bin spikes far from its main mass, and the
+    /// most probable bin lands on one of them at many pixels.
+    pub mode_window: usize,
 }
 
 impl Default for DppConfig {
@@ -263,6 +270,7 @@ impl Default for DppConfig {
             bins: 108,
             min: -3.5,
             max: 3.5,
+            mode_window: 0,
         }
     }
 }
@@ -600,6 +608,13 @@ impl TrainConfig {
         if self.dpp.bins < 2 || self.dpp.max <= self.dpp.min {
             bail!("dpp needs ≥ 2 bins over a non-empty range");
         }
+        if 2 * self.dpp.mode_window >= self.dpp.bins {
+            bail!(
+                "dpp.mode_window {} spans more than the {} bins",
+                self.dpp.mode_window,
+                self.dpp.bins
+            );
+        }
         if !(1..=4).contains(&self.test_rotations) {
             bail!(
                 "test_rotations must be 1 to 4 quarter turns, got {}",
@@ -772,9 +787,10 @@ mod tests {
         assert_eq!(cfg.augment.max_downscale, 1);
     }
 
-    /// The field recipe differs from cpu_small only in depth and in the thesis' warm-up and
-    /// Adam epsilon (the deeper net stalled without them), and its field reaches a point at
-    /// 3.5 px in the outer views of a 9×9 grid (4 steps × 3.5 px = 14 px).
+    /// The field recipe differs from cpu_small only in depth, in the thesis' warm-up and Adam
+    /// epsilon (the deeper net stalled without them) and in DPP's point estimate (a 5-bin
+    /// mode), and its field reaches a point at 3.5 px in the outer views of a 9×9 grid (4
+    /// steps × 3.5 px = 14 px).
     #[test]
     fn the_field_recipe_reaches_the_outer_views() {
         let small: TrainConfig = toml::from_str(include_str!("../configs/cpu_small.toml")).unwrap();
@@ -793,6 +809,10 @@ mod tests {
                 net: deeper,
                 warmup_steps: 1000,
                 adam_epsilon: 1e-8,
+                dpp: DppConfig {
+                    mode_window: 2,
+                    ..small.dpp.clone()
+                },
                 ..small
             }
         );
@@ -933,5 +953,20 @@ mod tests {
         assert!(with("test_rotations = 5").unwrap_err().contains("1 to 4"));
         let epishift = "model = \"epishift\"\npatch = 64\ntest_rotations = 4";
         assert!(with(epishift).unwrap_err().contains("epishift takes 1"));
+    }
+
+    #[test]
+    fn the_dpp_mode_window_must_fit_in_the_bins() {
+        let with = |text: &str| {
+            let cfg: TrainConfig = toml::from_str(text).unwrap();
+            cfg.validate().map_err(|e| e.to_string())
+        };
+        assert_eq!(TrainConfig::default().dpp.mode_window, 0);
+        assert!(with("[dpp]\nmode_window = 53").is_ok());
+        assert!(
+            with("[dpp]\nmode_window = 54")
+                .unwrap_err()
+                .contains("mode_window")
+        );
     }
 }

@@ -59,6 +59,10 @@ enum Command {
         /// turns, 1 to 4 (overrides the run's test_rotations; 1: off).
         #[arg(long, value_name = "N")]
         rotations: Option<usize>,
+        /// DPP's point estimate: the most likely mode over 2R + 1 bins (overrides the run's
+        /// dpp.mode_window; 0: the most probable bin, as the thesis).
+        #[arg(long, value_name = "R")]
+        mode_window: Option<usize>,
     },
     /// Seconds per training step of a configuration on random input (no data loading), or
     /// with --loader the crops/s of the data loader alone.
@@ -223,11 +227,13 @@ fn run(cli: Cli) -> Result<()> {
             range,
             coarse_max,
             rotations,
+            mode_window,
         } => {
             let overrides = Overrides {
                 range,
                 coarse_max,
                 rotations,
+                mode_window,
             };
             let n = predict_dataset_over(&run, &dataset, &out, cli.quiet, &overrides)?;
             eprintln!("lftrain: {n} scenes written to {}", out.display());

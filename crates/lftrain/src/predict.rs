@@ -134,7 +134,16 @@ fn predict_epinet(
                 height: h,
                 form,
             };
-            (point_estimates(&map), Some(map))
+            let disparity = match &map.form {
+                PosteriorForm::Discrete { bins, probs } if cfg.dpp.mode_window > 0 => {
+                    let modes = (probs.chunks_exact(bins.count))
+                        .map(|p| window_mode(p, bins, cfg.dpp.mode_window))
+                        .collect();
+                    FloatImage::new(w, h, modes)
+                }
+                _ => point_estimates(&map),
+            };
+            (disparity, Some(map))
         }
     };
     ScenePrediction {
@@ -189,6 +198,37 @@ fn dpp_posterior(cfg: &TrainConfig, planes: Vec<Vec<f32>>) -> PosteriorForm {
     PosteriorForm::Discrete { bins, probs }
 }
 
+/// The most likely mode of one pixel's discrete posterior `probs` over `bins` at a scale of
+/// `2r + 1` bins ([`crate::config::DppConfig::mode_window`]): the bin whose window `k − r ..=
+/// k + r` (clipped to the bins) holds the most probability (the first on ties), and the mean
+/// of that window's centres weighted by their probability. `r = 0` is the most probable
+/// bin's centre.
+pub fn window_mode(probs: &[f32], bins: &Bins, r: usize) -> f32 {
+    let n = probs.len();
+    let p = |j: usize| f64::from(probs[j]);
+    let mut sum: f64 = (0..n.min(r + 1)).map(p).sum();
+    let (mut best, mut best_sum) = (0, sum);
+    for k in 1..n {
+        if k + r < n {
+            sum += p(k + r);
+        }
+        if k > r {
+            sum -= p(k - r - 1);
+        }
+        if sum > best_sum {
+            (best, best_sum) = (k, sum);
+        }
+    }
+    let window = best.saturating_sub(r)..(best + r + 1).min(n);
+    let mass: f64 = window.clone().map(p).sum();
+    let moment: f64 = window.map(|j| p(j) * bins.centre(j)).sum();
+    if mass > 0.0 {
+        (moment / mass) as f32
+    } else {
+        bins.centre(best) as f32
+    }
+}
+
 /// `lftrain predict`: the run's checkpoint applied to every scene of `dataset`, written to
 /// `out` in lfeval's layout (`disp_maps/`, `posteriors/`, `runtimes/`). Returns the scene count.
 pub fn predict_dataset(
@@ -210,35 +250,50 @@ pub struct Overrides {
     pub coarse_max: Option<f32>,
     /// `--rotations`: [`TrainConfig::test_rotations`].
     pub rotations: Option<usize>,
+    /// `--mode-window`: [`crate::config::DppConfig::mode_window`].
+    pub mode_window: Option<usize>,
 }
 
 impl Overrides {
-    /// `cfg` with these overrides, refused where they do not apply to its model or are out
-    /// of range (the error names the flag).
+    /// `cfg` with these overrides, refused where a flag does not apply to its model or the
+    /// result is invalid (the error names the flags).
     fn apply(&self, mut cfg: TrainConfig) -> anyhow::Result<TrainConfig> {
-        let name = cfg.model.name();
+        use ModelKind::{Dpp, EpiShift, Ese};
+        let model = cfg.model;
+        let only = |flag: &str, models: &[ModelKind]| {
+            let names: Vec<_> = models.iter().map(|m| m.name()).collect();
+            anyhow::ensure!(
+                models.contains(&model),
+                "{flag} applies to {} runs, this is {}",
+                names.join(" and "),
+                model.name()
+            );
+            Ok(())
+        };
+        let mut given = Vec::new();
         if let Some(c) = self.coarse_max {
-            if cfg.model != ModelKind::EpiShift {
-                anyhow::bail!("--coarse-max applies to epishift runs, this is {name}");
-            }
+            only("--coarse-max", &[EpiShift])?;
             cfg.epishift.coarse_max = c;
-            cfg.validate()
-                .map_err(|e| e.context(format!("--coarse-max {c}")))?;
+            given.push(format!("--coarse-max {c}"));
         }
         if let Some(r) = self.range {
-            match cfg.model {
-                ModelKind::EpiShift => cfg.epishift.range = Some(r),
-                ModelKind::Ese => cfg.ese.range = Some(r),
-                _ => anyhow::bail!("--range applies to epishift and ese runs, this is {name}"),
+            only("--range", &[EpiShift, Ese])?;
+            match model {
+                EpiShift => cfg.epishift.range = Some(r),
+                _ => cfg.ese.range = Some(r),
             }
-            cfg.validate()
-                .map_err(|e| e.context(format!("--range {},{}", r[0], r[1])))?;
+            given.push(format!("--range {},{}", r[0], r[1]));
         }
         if let Some(k) = self.rotations {
             cfg.test_rotations = k;
-            cfg.validate()
-                .map_err(|e| e.context(format!("--rotations {k}")))?;
+            given.push(format!("--rotations {k}"));
         }
+        if let Some(r) = self.mode_window {
+            only("--mode-window", &[Dpp])?;
+            cfg.dpp.mode_window = r;
+            given.push(format!("--mode-window {r}"));
+        }
+        cfg.validate().map_err(|e| e.context(given.join(" ")))?;
         Ok(cfg)
     }
 }
@@ -276,4 +331,85 @@ pub fn predict_dataset_over(
     }
     bar.finish_and_clear();
     Ok(scenes.len())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Bins of width 1 over [0, n): bin `k`'s centre is `k + 0.5`.
+    fn unit_bins(n: usize) -> Bins {
+        Bins::new(0.0, n as f64, n).unwrap()
+    }
+
+    #[test]
+    fn window_zero_is_the_most_probable_bin() {
+        let probs = [0.1, 0.3, 0.2, 0.3, 0.1];
+        assert_eq!(
+            window_mode(&probs, &unit_bins(5), 0),
+            1.5,
+            "first of the tied maxima"
+        );
+    }
+
+    #[test]
+    fn a_window_prefers_the_broad_mode_to_a_lone_spike() {
+        // A spike of 0.2 at bin 0; a mode of 3 × 0.16 at bins 5, 6, 7; 0.32 spread thinly.
+        let mut probs = [0.02f32; 12];
+        probs[0] = 0.2;
+        probs[5..8].fill(0.16);
+        assert_eq!(window_mode(&probs, &unit_bins(12), 0), 0.5);
+        // Window 6 ± 1 holds 0.48: its weighted mean is centre 6.
+        assert!((window_mode(&probs, &unit_bins(12), 1) - 6.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn the_estimate_is_the_probability_weighted_mean_of_the_window() {
+        // Windows of 3: bin 4's (0.1 + 0.3 + 0.2 = 0.6) beats bin 3's (0.4) and bin 5's (0.5);
+        // (0.1·3.5 + 0.3·4.5 + 0.2·5.5) / 0.6 = 2.8 / 0.6.
+        let probs = [0.0, 0.0, 0.0, 0.1, 0.3, 0.2, 0.0, 0.0];
+        let d = window_mode(&probs, &unit_bins(8), 1);
+        assert!((d - 2.8 / 0.6).abs() < 1e-6, "{d}");
+    }
+
+    #[test]
+    fn windows_are_clipped_at_the_first_and_last_bins() {
+        // All mass in bins 0 and 1: the window around bin 0 is 0..=2 clipped to 0..=2, mean 1.0.
+        let probs = [0.5, 0.5, 0.0, 0.0, 0.0, 0.0];
+        assert!((window_mode(&probs, &unit_bins(6), 2) - 1.0).abs() < 1e-6);
+        // Mirrored at the last bins: (0.5·4.5 + 0.5·5.5) = 5.0.
+        let probs = [0.0, 0.0, 0.0, 0.0, 0.5, 0.5];
+        assert!((window_mode(&probs, &unit_bins(6), 2) - 5.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn predict_flags_are_refused_where_they_do_not_apply() {
+        let cfg = |model| TrainConfig {
+            model,
+            ..TrainConfig::default()
+        };
+        let err = |o: Overrides, model| o.apply(cfg(model)).unwrap_err().to_string();
+        let window = Overrides {
+            mode_window: Some(2),
+            ..Default::default()
+        };
+        assert_eq!(
+            window.apply(cfg(ModelKind::Dpp)).unwrap().dpp.mode_window,
+            2
+        );
+        assert_eq!(
+            err(window, ModelKind::Upr),
+            "--mode-window applies to dpp runs, this is upr"
+        );
+        let range = Overrides {
+            range: Some([-40.0, 40.0]),
+            ..Default::default()
+        };
+        assert!(err(range, ModelKind::Base).contains("epishift and ese runs"));
+        let turns = Overrides {
+            rotations: Some(5),
+            ..Default::default()
+        };
+        assert!(err(turns, ModelKind::Base).starts_with("--rotations 5"));
+    }
 }

@@ -303,6 +303,9 @@ fn every_model_writes_a_posterior_lfeval_reads() {
             &dev,
         ));
         let pred = lftrain::predict::predict(&c, &net, &lf, &dev);
+        if model == ModelKind::Dpp {
+            dpp_point_is_the_window_mode(c.clone(), &net, &lf, &dev);
+        }
         let dir = tmp.path().join(model.name());
         lfeval::prediction::write_prediction(&dir, "s", &pred).unwrap();
         let back = lfeval::prediction::Method::new(&dir)
@@ -430,4 +433,31 @@ fn test_rotations_turn_the_prediction_with_the_light_field() {
     // make the net itself not rotation-equivariant), so the check above could fail.
     let (gap, spread) = gap_and_spread(1);
     assert!(gap > 1e-2 * spread, "{gap} of {spread}");
+}
+
+/// With `dpp.mode_window = 2` DPP's disparity map is [`window_mode`] of its own posterior
+/// at every pixel (and, on this untrained net, not the most probable bin everywhere).
+fn dpp_point_is_the_window_mode(
+    mut c: TrainConfig,
+    net: &lftrain::model::Network,
+    lf: &lftrain::lightfield::LightField,
+    dev: &Device,
+) {
+    use lfeval::posterior::PosteriorForm;
+    use lftrain::predict::window_mode;
+    c.dpp.mode_window = 2;
+    let pred = lftrain::predict::predict(&c, net, lf, dev);
+    let Some(PosteriorForm::Discrete { bins, probs }) = pred.posterior.map(|p| p.form) else {
+        panic!("DPP gives a discrete posterior");
+    };
+    let pixels = probs.chunks_exact(bins.count);
+    let (mut differs, d) = (false, &pred.disparity.data);
+    for (i, p) in pixels.enumerate() {
+        assert_eq!(d[i], window_mode(p, &bins, 2), "pixel {i}");
+        differs |= d[i] != window_mode(p, &bins, 0);
+    }
+    assert!(
+        differs,
+        "the window changed no pixel: the check could not fail"
+    );
 }
