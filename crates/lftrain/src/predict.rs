@@ -202,10 +202,15 @@ fn dpp_posterior(cfg: &TrainConfig, planes: Vec<Vec<f32>>) -> PosteriorForm {
 /// `2r + 1` bins ([`crate::config::DppConfig::mode_window`]): the bin whose window `k − r ..=
 /// k + r` (clipped to the bins) holds the most probability (the first on ties), and the mean
 /// of that window's centres weighted by their probability. `r = 0` is the most probable
-/// bin's centre.
+/// bin's centre. NaN where the probabilities are not a usable distribution (a non-finite or
+/// non-positive total), as lfeval's own point estimate, so its invalid-pixel count sees it.
 pub fn window_mode(probs: &[f32], bins: &Bins, r: usize) -> f32 {
     let n = probs.len();
     let p = |j: usize| f64::from(probs[j]);
+    let total: f64 = (0..n).map(p).sum();
+    if !(total.is_finite() && total > 0.0) {
+        return f32::NAN;
+    }
     let mut sum: f64 = (0..n.min(r + 1)).map(p).sum();
     let (mut best, mut best_sum) = (0, sum);
     for k in 1..n {
@@ -222,11 +227,7 @@ pub fn window_mode(probs: &[f32], bins: &Bins, r: usize) -> f32 {
     let window = best.saturating_sub(r)..(best + r + 1).min(n);
     let mass: f64 = window.clone().map(p).sum();
     let moment: f64 = window.map(|j| p(j) * bins.centre(j)).sum();
-    if mass > 0.0 {
-        (moment / mass) as f32
-    } else {
-        bins.centre(best) as f32
-    }
+    (moment / mass) as f32
 }
 
 /// `lftrain predict`: the run's checkpoint applied to every scene of `dataset`, written to
@@ -370,6 +371,13 @@ mod tests {
         let probs = [0.0, 0.0, 0.0, 0.1, 0.3, 0.2, 0.0, 0.0];
         let d = window_mode(&probs, &unit_bins(8), 1);
         assert!((d - 2.8 / 0.6).abs() < 1e-6, "{d}");
+    }
+
+    #[test]
+    fn an_unusable_posterior_gives_nan() {
+        let bins = unit_bins(3);
+        assert!(window_mode(&[0.5, f32::NAN, 0.5], &bins, 1).is_nan());
+        assert!(window_mode(&[0.0; 3], &bins, 1).is_nan());
     }
 
     #[test]
