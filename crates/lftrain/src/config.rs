@@ -175,6 +175,23 @@ pub struct EseConfig {
     /// out-of-range `log b` grows without end). 5 is b ≈ 148 px, past any range.
     #[serde(default = "default_max_log_b")]
     pub max_log_b: f32,
+    /// The point estimate (the disparity map lfeval scores MSE and BadPix on).
+    #[serde(default)]
+    pub point: EsePoint,
+}
+
+/// Which disparity of the ESE mixture is its point estimate.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum EsePoint {
+    /// The centre of the pass with the highest peak `w / 2b` (mmlf: the pass with the least
+    /// `b`): one over-confident pass decides the pixel.
+    #[default]
+    Peak,
+    /// The mixture's own most likely mode: the pass centre where the mixture's density is
+    /// highest (not in the thesis). Passes that agree on a disparity add up there, so a
+    /// lone over-confident pass no longer wins; O(M²) per pixel.
+    Mode,
 }
 
 fn default_max_log_b() -> f32 {
@@ -241,6 +258,7 @@ impl Default for EseConfig {
             scene_range: false,
             outside: EseOutside::Ignore,
             max_log_b: default_max_log_b(),
+            point: EsePoint::Peak,
         }
     }
 }

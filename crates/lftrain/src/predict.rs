@@ -10,7 +10,7 @@ use lfeval::posterior::{PosteriorForm, PosteriorMap};
 use lfeval::prediction::{ScenePrediction, point_estimates};
 use lfformat::pfm::FloatImage;
 
-use crate::config::{ModelKind, TrainConfig};
+use crate::config::{EsePoint, ModelKind, TrainConfig};
 use crate::epishift::EpiShiftNet;
 use crate::lightfield::{LightField, rotate_plane};
 use crate::model::{EpiNet, Network};
@@ -141,6 +141,18 @@ fn predict_epinet(
                         .collect();
                     FloatImage::new(w, h, modes)
                 }
+                PosteriorForm::Mixture {
+                    components: m,
+                    weights,
+                    mu,
+                    log_b,
+                } if cfg.ese.point == EsePoint::Mode => {
+                    let pixels = weights.chunks_exact(*m).zip(mu.chunks_exact(*m));
+                    let modes = (pixels.zip(log_b.chunks_exact(*m)))
+                        .map(|((w, mu), lb)| mixture_mode(w, mu, lb))
+                        .collect();
+                    FloatImage::new(w, h, modes)
+                }
                 _ => point_estimates(&map),
             };
             (disparity, Some(map))
@@ -228,6 +240,33 @@ pub fn window_mode(probs: &[f32], bins: &Bins, r: usize) -> f32 {
     let mass: f64 = window.clone().map(p).sum();
     let moment: f64 = window.map(|j| p(j) * bins.centre(j)).sum();
     (moment / mass) as f32
+}
+
+/// The most likely mode of a mixture of Laplacians `Σ w_k Laplace(μ_k, e^{log b_k})`
+/// ([`EsePoint::Mode`]): the component centre `μ_j` where the mixture's density is highest
+/// (the first on ties). NaN where the weights are not a usable distribution or no centre
+/// has a finite density.
+pub fn mixture_mode(weights: &[f32], mu: &[f32], log_b: &[f32]) -> f32 {
+    let total: f64 = weights.iter().map(|&w| f64::from(w)).sum();
+    if !(total.is_finite() && total > 0.0) {
+        return f32::NAN;
+    }
+    let density = |x: f64| -> f64 {
+        (weights.iter().zip(mu).zip(log_b))
+            .map(|((&w, &m), &lb)| {
+                let b = f64::from(lb).exp();
+                f64::from(w) / (2.0 * b) * (-(x - f64::from(m)).abs() / b).exp()
+            })
+            .sum()
+    };
+    let mut best = (f64::NEG_INFINITY, f32::NAN);
+    for &m in mu {
+        let d = density(m.into());
+        if d.is_finite() && d > best.0 {
+            best = (d, m);
+        }
+    }
+    best.1
 }
 
 /// `lftrain predict`: the run's checkpoint applied to every scene of `dataset`, written to
@@ -371,6 +410,22 @@ mod tests {
         let probs = [0.0, 0.0, 0.0, 0.1, 0.3, 0.2, 0.0, 0.0];
         let d = window_mode(&probs, &unit_bins(8), 1);
         assert!((d - 2.8 / 0.6).abs() < 1e-6, "{d}");
+    }
+
+    #[test]
+    fn the_mixture_mode_is_where_passes_agree_not_the_sharpest_pass() {
+        // Two passes agree near 1.0 (b = 0.2); a lone sharper pass sits at 3.0 (b = 0.15).
+        let (w, mu) = ([1.0 / 3.0; 3], [1.0f32, 1.05, 3.0]);
+        let log_b = [0.2f32.ln(), 0.2f32.ln(), 0.15f32.ln()];
+        // Peaks w / 2b: 0.83, 0.83, 1.11 — the highest peak is the lone pass.
+        // Density at 1.0 and at 1.05: (1/3)/0.4 · (1 + e^{-0.25}) = 1.482, plus what the pass
+        // at 3.0 adds (1.1 · e^{-2/0.15} = 1.8e-6 and 1.1 · e^{-1.95/0.15} = 2.5e-6, so 1.05
+        // wins); at 3.0: 1.111 + 1e-4.
+        assert_eq!(mixture_mode(&w, &mu, &log_b), 1.05);
+        // Without the agreeing pass the sharp one wins.
+        assert_eq!(mixture_mode(&w[..2], &mu[1..], &log_b[1..]), 3.0);
+        assert!(mixture_mode(&[0.0, 0.0], &mu[..2], &log_b[..2]).is_nan());
+        assert!(mixture_mode(&[0.5, f32::NAN], &mu[..2], &log_b[..2]).is_nan());
     }
 
     #[test]

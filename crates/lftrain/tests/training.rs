@@ -303,8 +303,8 @@ fn every_model_writes_a_posterior_lfeval_reads() {
             &dev,
         ));
         let pred = lftrain::predict::predict(&c, &net, &lf, &dev);
-        if model == ModelKind::Dpp {
-            dpp_point_is_the_window_mode(c.clone(), &net, &lf, &dev);
+        if matches!(model, ModelKind::Dpp | ModelKind::Ese) {
+            point_follows_the_config(c.clone(), &net, &lf, &dev);
         }
         let dir = tmp.path().join(model.name());
         lfeval::prediction::write_prediction(&dir, "s", &pred).unwrap();
@@ -435,29 +435,46 @@ fn test_rotations_turn_the_prediction_with_the_light_field() {
     assert!(gap > 1e-2 * spread, "{gap} of {spread}");
 }
 
-/// With `dpp.mode_window = 2` DPP's disparity map is [`window_mode`] of its own posterior
-/// at every pixel (and, on this untrained net, not the most probable bin everywhere).
-fn dpp_point_is_the_window_mode(
+/// DPP's disparity map with `dpp.mode_window = 2` and ESE's with `ese.point = "mode"` are
+/// [`window_mode`] and [`mixture_mode`] of their own posteriors at every pixel (and, on this
+/// untrained net, not the default point estimate everywhere, so the check can fail).
+fn point_follows_the_config(
     mut c: TrainConfig,
     net: &lftrain::model::Network,
     lf: &lftrain::lightfield::LightField,
     dev: &Device,
 ) {
     use lfeval::posterior::PosteriorForm;
-    use lftrain::predict::window_mode;
+    use lftrain::predict::{mixture_mode, window_mode};
     c.dpp.mode_window = 2;
+    c.ese.point = lftrain::config::EsePoint::Mode;
     let pred = lftrain::predict::predict(&c, net, lf, dev);
-    let Some(PosteriorForm::Discrete { bins, probs }) = pred.posterior.map(|p| p.form) else {
-        panic!("DPP gives a discrete posterior");
+    let d = &pred.disparity.data;
+    // (the configured estimate, the default one) of pixel i.
+    let expected: Box<dyn Fn(usize) -> (f32, f32)> = match pred.posterior.map(|p| p.form) {
+        Some(PosteriorForm::Discrete { bins, probs }) => Box::new(move |i| {
+            let p = &probs[i * bins.count..(i + 1) * bins.count];
+            (window_mode(p, &bins, 2), window_mode(p, &bins, 0))
+        }),
+        Some(PosteriorForm::Mixture {
+            components: m,
+            weights,
+            mu,
+            log_b,
+        }) => Box::new(move |i| {
+            let at = |v: &[f32]| v[i * m..(i + 1) * m].to_vec();
+            let (w, mu, lb) = (at(&weights), at(&mu), at(&log_b));
+            let peak =
+                (0..m).max_by(|&a, &b| (w[a] / lb[a].exp()).total_cmp(&(w[b] / lb[b].exp())));
+            (mixture_mode(&w, &mu, &lb), mu[peak.unwrap()])
+        }),
+        _ => panic!("{:?} has no configurable point estimate", c.model),
     };
-    let pixels = probs.chunks_exact(bins.count);
-    let (mut differs, d) = (false, &pred.disparity.data);
-    for (i, p) in pixels.enumerate() {
-        assert_eq!(d[i], window_mode(p, &bins, 2), "pixel {i}");
-        differs |= d[i] != window_mode(p, &bins, 0);
+    let mut differs = false;
+    for (i, &di) in d.iter().enumerate() {
+        let (new, default) = expected(i);
+        assert_eq!(di, new, "{:?} pixel {i}", c.model);
+        differs |= di != default;
     }
-    assert!(
-        differs,
-        "the window changed no pixel: the check could not fail"
-    );
+    assert!(differs, "{:?}: the option changed no pixel", c.model);
 }
