@@ -26,6 +26,11 @@ pub fn mass(mu: f64, b: f64, lo: f64, hi: f64) -> f64 {
     }
 }
 
+/// Density `exp(-|x - μ| / b) / 2b` of `Laplace(mu, b)` at `x` (`b > 0`).
+pub fn density(mu: f64, b: f64, x: f64) -> f64 {
+    (-(x - mu).abs() / b).exp() / (2.0 * b)
+}
+
 /// Variance `2b²` of `Laplace(μ, b)`.
 pub fn variance(b: f64) -> f64 {
     2.0 * b * b
@@ -34,6 +39,16 @@ pub fn variance(b: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn density_is_the_derivative_of_the_mass() {
+        let (mu, b, h) = (0.3, 0.7, 1e-6);
+        for x in [-2.0, 0.1, 0.3, 1.9] {
+            let numeric = mass(mu, b, x - h, x + h) / (2.0 * h);
+            assert!((density(mu, b, x) - numeric).abs() < 1e-6, "{x}");
+        }
+        assert_eq!(density(mu, b, mu), 1.0 / 1.4);
+    }
 
     fn close(a: f64, b: f64) -> bool {
         (a - b).abs() < 1e-12

@@ -5,9 +5,9 @@
 use std::time::Instant;
 
 use burn::prelude::*;
-use lfeval::Bins;
-use lfeval::posterior::{PosteriorForm, PosteriorMap};
-use lfeval::prediction::{ScenePrediction, point_estimates};
+use lfeval::posterior::{PixelPosterior, PosteriorForm, PosteriorMap};
+use lfeval::prediction::ScenePrediction;
+use lfeval::{Bins, laplace};
 use lfformat::pfm::FloatImage;
 
 use crate::config::{EsePoint, ModelKind, TrainConfig};
@@ -134,27 +134,18 @@ fn predict_epinet(
                 height: h,
                 form,
             };
-            let disparity = match &map.form {
-                PosteriorForm::Discrete { bins, probs } if cfg.dpp.mode_window > 0 => {
-                    let modes = (probs.chunks_exact(bins.count))
-                        .map(|p| window_mode(p, bins, cfg.dpp.mode_window))
-                        .collect();
-                    FloatImage::new(w, h, modes)
+            let point = |i| match map.pixel(i) {
+                PixelPosterior::Discrete { bins, probs } if cfg.dpp.mode_window > 0 => {
+                    window_mode(probs, bins, cfg.dpp.mode_window)
                 }
-                PosteriorForm::Mixture {
-                    components: m,
-                    weights,
-                    mu,
-                    log_b,
-                } if cfg.ese.point == EsePoint::Mode => {
-                    let pixels = weights.chunks_exact(*m).zip(mu.chunks_exact(*m));
-                    let modes = (pixels.zip(log_b.chunks_exact(*m)))
-                        .map(|((w, mu), lb)| mixture_mode(w, mu, lb))
-                        .collect();
-                    FloatImage::new(w, h, modes)
+                PixelPosterior::Mixture { weights, mu, log_b }
+                    if cfg.ese.point == EsePoint::Mode =>
+                {
+                    mixture_mode(weights, mu, log_b)
                 }
-                _ => point_estimates(&map),
+                other => other.point_estimate() as f32,
             };
+            let disparity = FloatImage::new(w, h, (0..w * h).map(point).collect());
             (disparity, Some(map))
         }
     };
@@ -254,8 +245,7 @@ pub fn mixture_mode(weights: &[f32], mu: &[f32], log_b: &[f32]) -> f32 {
     let density = |x: f64| -> f64 {
         (weights.iter().zip(mu).zip(log_b))
             .map(|((&w, &m), &lb)| {
-                let b = f64::from(lb).exp();
-                f64::from(w) / (2.0 * b) * (-(x - f64::from(m)).abs() / b).exp()
+                f64::from(w) * laplace::density(m.into(), f64::from(lb).exp(), x)
             })
             .sum()
     };

@@ -444,37 +444,22 @@ fn point_follows_the_config(
     lf: &lftrain::lightfield::LightField,
     dev: &Device,
 ) {
-    use lfeval::posterior::PosteriorForm;
+    use lfeval::posterior::PixelPosterior;
     use lftrain::predict::{mixture_mode, window_mode};
     c.dpp.mode_window = 2;
     c.ese.point = lftrain::config::EsePoint::Mode;
     let pred = lftrain::predict::predict(&c, net, lf, dev);
-    let d = &pred.disparity.data;
-    // (the configured estimate, the default one) of pixel i.
-    let expected: Box<dyn Fn(usize) -> (f32, f32)> = match pred.posterior.map(|p| p.form) {
-        Some(PosteriorForm::Discrete { bins, probs }) => Box::new(move |i| {
-            let p = &probs[i * bins.count..(i + 1) * bins.count];
-            (window_mode(p, &bins, 2), window_mode(p, &bins, 0))
-        }),
-        Some(PosteriorForm::Mixture {
-            components: m,
-            weights,
-            mu,
-            log_b,
-        }) => Box::new(move |i| {
-            let at = |v: &[f32]| v[i * m..(i + 1) * m].to_vec();
-            let (w, mu, lb) = (at(&weights), at(&mu), at(&log_b));
-            let peak =
-                (0..m).max_by(|&a, &b| (w[a] / lb[a].exp()).total_cmp(&(w[b] / lb[b].exp())));
-            (mixture_mode(&w, &mu, &lb), mu[peak.unwrap()])
-        }),
-        _ => panic!("{:?} has no configurable point estimate", c.model),
-    };
+    let map = pred.posterior.expect("DPP and ESE give posteriors");
     let mut differs = false;
-    for (i, &di) in d.iter().enumerate() {
-        let (new, default) = expected(i);
-        assert_eq!(di, new, "{:?} pixel {i}", c.model);
-        differs |= di != default;
+    for (i, &d) in pred.disparity.data.iter().enumerate() {
+        let pixel = map.pixel(i);
+        let configured = match pixel {
+            PixelPosterior::Discrete { bins, probs } => window_mode(probs, bins, 2),
+            PixelPosterior::Mixture { weights, mu, log_b } => mixture_mode(weights, mu, log_b),
+            PixelPosterior::Laplace { .. } => panic!("{:?} has no configurable estimate", c.model),
+        };
+        assert_eq!(d, configured, "{:?} pixel {i}", c.model);
+        differs |= d != pixel.point_estimate() as f32;
     }
     assert!(differs, "{:?}: the option changed no pixel", c.model);
 }
