@@ -5,6 +5,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
+use lfeval::bins::Bins;
 use serde::{Deserialize, Serialize};
 
 /// The four posterior models of the thesis (§5.2.1) and EPI-Shift (chapter 4).
@@ -26,12 +27,22 @@ pub enum ModelKind {
 }
 
 impl ModelKind {
-    /// Network output channels.
+    /// Output channels of the model (what the losses and predictions read).
     pub fn out_channels(self, dpp_bins: usize) -> usize {
         match self {
             ModelKind::Base => 1,
             ModelKind::Upr | ModelKind::Ese | ModelKind::EpiShift => 2,
             ModelKind::Dpp => dpp_bins,
+        }
+    }
+
+    /// Channels of the network's last layer for `input`: the output channels on views; on a
+    /// cost volume one logit per bin, plus `log b` for UPR and ESE (see [`NetInput::Cost`]).
+    pub fn net_channels(self, input: NetInput, dpp_bins: usize) -> usize {
+        match (input, self) {
+            (NetInput::Views, _) => self.out_channels(dpp_bins),
+            (NetInput::Cost, ModelKind::Base | ModelKind::Dpp) => dpp_bins,
+            (NetInput::Cost, _) => dpp_bins + 1,
         }
     }
 
@@ -73,6 +84,24 @@ pub struct NetConfig {
     pub head_width: usize,
     /// Output-stream blocks at `head_width`, before the final block to the output channels (7).
     pub head_blocks: usize,
+    /// What each of the four input streams reads (the thesis: the stack's views).
+    pub input: NetInput,
+}
+
+/// The network's input per stack direction.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NetInput {
+    /// The stack's views, `n × 3` planes (thesis appendix B.1).
+    Views,
+    /// The stack's plane-sweep cost volume: for every `[dpp]` bin centre `h`, the colour
+    /// variance of the stack's views EPI-shifted by `h` ([`crate::cost`]). The network then
+    /// scores the hypotheses (one logit each, and UPR's and ESE's `log b`) and BASE, UPR and
+    /// ESE take their disparity as the softmax-weighted mean of the bin centres (a soft
+    /// argmin, as GC-Net's), DPP the logits as its posterior. Not in the thesis: a CPU-budget
+    /// net on the views learns sub-pixel matching too slowly to beat the classical baseline's
+    /// BadPix, while here the matching is given and the net learns to aggregate it.
+    Cost,
 }
 
 impl NetConfig {
@@ -91,6 +120,7 @@ impl Default for NetConfig {
             stream_blocks: 3,
             head_width: 280,
             head_blocks: 7,
+            input: NetInput::Views,
         }
     }
 }
@@ -280,6 +310,13 @@ pub struct DppConfig {
     /// under-trained net's posterior has single-bin spikes far from its main mass, and the
     /// most probable bin lands on one of them at many pixels.
     pub mode_window: usize,
+}
+
+impl DppConfig {
+    /// The bins (validated by [`TrainConfig::validate`]).
+    pub fn bins(&self) -> Bins {
+        Bins::new(self.min as f64, self.max as f64, self.bins).expect("validated DPP bins")
+    }
 }
 
 impl Default for DppConfig {
@@ -626,6 +663,9 @@ impl TrainConfig {
         if self.dpp.bins < 2 || self.dpp.max <= self.dpp.min {
             bail!("dpp needs ≥ 2 bins over a non-empty range");
         }
+        if self.net.input == NetInput::Cost && self.model == ModelKind::EpiShift {
+            bail!("net.input = \"cost\" is for BASE, UPR, ESE and DPP; EPI-Shift reads views");
+        }
         if 2 * self.dpp.mode_window >= self.dpp.bins {
             bail!(
                 "dpp.mode_window {} spans more than the {} bins",
@@ -834,6 +874,37 @@ mod tests {
                 ..small
             }
         );
+    }
+
+    /// The cost recipe is the field recipe's schedule on a cost volume: 48 hypotheses over
+    /// ±3.5 px, a smaller net, no EPI shift (the targets must stay inside the hypotheses).
+    #[test]
+    fn the_cost_recipe_reads_cost_volumes_and_refuses_epishift() {
+        let field: TrainConfig = toml::from_str(include_str!("../configs/cpu_field.toml")).unwrap();
+        let cost: TrainConfig = toml::from_str(include_str!("../configs/cpu_cost.toml")).unwrap();
+        cost.validate().unwrap();
+        assert_eq!(cost.net.input, NetInput::Cost);
+        assert_eq!((cost.dpp.bins, cost.dpp.min, cost.dpp.max), (48, -3.5, 3.5));
+        assert_eq!(cost.augment.max_shift, 0.0);
+        assert_eq!(cost.net.receptive_radius(), 9);
+        assert_eq!(
+            (cost.steps, cost.warmup_steps, cost.learning_rate),
+            (field.steps, field.warmup_steps, field.learning_rate)
+        );
+        assert_eq!(TrainConfig::default().net.input, NetInput::Views);
+        // One logit per hypothesis, and log b for UPR and ESE.
+        let channels = |m: ModelKind| m.net_channels(NetInput::Cost, 48);
+        assert_eq!(channels(ModelKind::Base), 48);
+        assert_eq!(channels(ModelKind::Upr), 49);
+        assert_eq!(channels(ModelKind::Ese), 49);
+        assert_eq!(channels(ModelKind::Dpp), 48);
+        assert_eq!(ModelKind::Upr.net_channels(NetInput::Views, 48), 2);
+        let shift = TrainConfig {
+            model: ModelKind::EpiShift,
+            ..cost
+        };
+        let err = shift.validate().unwrap_err().to_string();
+        assert!(err.contains("net.input"), "{err}");
     }
 
     /// The GPU check's config is the thesis' recipe (the defaults) at batch 64 for 200 steps:

@@ -16,6 +16,7 @@ use rand_pcg::Pcg32;
 use rayon::prelude::*;
 
 use crate::config::{ModelKind, TrainConfig};
+use crate::input::StackInput;
 use crate::sample::{Batch, Draw, make_sample};
 use crate::scene::{Scene, Unimodal};
 use crate::shift_sample::{ShiftBatch, make_shift_sample};
@@ -119,6 +120,7 @@ fn run(
     tx: SyncSender<Result<TrainBatch>>,
 ) {
     let mut rng = Pcg32::new(cfg.seed, stream);
+    let input = StackInput::of(&cfg);
     let load = |d: &SceneDir| {
         let scene = Scene::load(&d.path, &d.name, cfg.target_modes(), Unimodal::of(&cfg))?;
         fits_patch(&scene, cfg.patch)?;
@@ -170,7 +172,7 @@ fn run(
         } else {
             let samples = draws
                 .into_par_iter()
-                .map(|(scene, draw)| make_sample(scene, &draw, patch, border))
+                .map(|(scene, draw)| make_sample(scene, &draw, patch, border, &input))
                 .collect();
             TrainBatch::Stacks(Batch::from_samples(samples, patch, cfg.target_modes()))
         };

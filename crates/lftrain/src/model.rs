@@ -5,10 +5,12 @@
 use burn::nn::conv::{Conv2d, Conv2dConfig};
 use burn::nn::{BatchNorm, BatchNormConfig, PaddingConfig2d};
 use burn::prelude::*;
-use burn::tensor::activation::relu;
+use burn::tensor::TensorData;
+use burn::tensor::activation::{relu, softmax};
 
-use crate::config::NetConfig;
+use crate::config::{ModelKind, NetConfig};
 use crate::epishift::EpiShiftNet;
+use crate::input::StackInput;
 
 /// A 2×2 convolution; `grow` pads by one on every side (size + 1), otherwise none (size − 1):
 /// the thesis alternates the two so that every block keeps the image size.
@@ -140,6 +142,30 @@ impl EpiNet {
         ];
         let x = chain(&self.head, Tensor::cat(features, 1));
         self.last_second.forward(relu(self.last_first.forward(x)))
+    }
+}
+
+/// The model's outputs (what [`crate::loss`] and [`crate::predict`] read) from the network's
+/// raw ones `[B, C, H, W]`: the same on views; on a cost volume, BASE's disparity and UPR's and
+/// ESE's `μ` are the softmax-weighted mean of the hypotheses over the first `K` channels (a
+/// soft argmin: differentiable, and finer than the hypotheses' spacing), UPR's and ESE's
+/// `log b` is channel `K`, and DPP's logits are the `K` channels themselves.
+pub fn decode(raw: Tensor<4>, model: ModelKind, input: &StackInput) -> Tensor<4> {
+    let StackInput::Cost(hypotheses) = input else {
+        return raw;
+    };
+    if model == ModelKind::Dpp {
+        return raw;
+    }
+    let k = hypotheses.len();
+    let centres = Tensor::<4>::from_data(
+        TensorData::new(hypotheses.clone(), [1, k, 1, 1]),
+        &raw.device(),
+    );
+    let mu = (softmax(raw.clone().narrow(1, 0, k), 1) * centres).sum_dim(1);
+    match model {
+        ModelKind::Base => mu,
+        _ => Tensor::cat(vec![mu, raw.narrow(1, k, 1)], 1),
     }
 }
 

@@ -12,10 +12,11 @@ use lfformat::pfm::FloatImage;
 
 use crate::config::{EsePoint, ModelKind, TrainConfig};
 use crate::epishift::EpiShiftNet;
+use crate::input::StackInput;
 use crate::lightfield::{LightField, rotate_plane};
-use crate::model::{EpiNet, Network};
+use crate::model::{EpiNet, Network, decode};
 use crate::shift_predict::estimate;
-use crate::stacks::{Direction, Region, extract};
+use crate::stacks::{Direction, Region};
 use crate::tensors::{tensor4, values};
 
 /// Raw network outputs `[C][H·W]` (channel planes) for `lf` EPI-shifted by `shift`, averaged
@@ -26,15 +27,18 @@ use crate::tensors::{tensor4, values};
 /// running statistics).
 pub fn run_net(
     net: &EpiNet,
+    model: ModelKind,
+    input: &StackInput,
     lf: &LightField,
     shift: f32,
     rotations: usize,
     device: &Device,
 ) -> Vec<Vec<f32>> {
-    let mut sum = run_once(net, lf, shift, device);
+    let once = |lf: &LightField| run_once(net, model, input, lf, shift, device);
+    let mut sum = once(lf);
     for turns in 1..rotations {
         let turned = lf.rotate(turns);
-        let planes = run_once(net, &turned, shift, device);
+        let planes = once(&turned);
         for (total, plane) in sum.iter_mut().zip(planes) {
             let back = turn_plane(plane, turned.width, turned.height, 4 - turns);
             total.iter_mut().zip(back).for_each(|(t, v)| *t += v);
@@ -45,12 +49,20 @@ pub fn run_net(
     sum
 }
 
-/// The network's output planes for `lf` as it is.
-fn run_once(net: &EpiNet, lf: &LightField, shift: f32, device: &Device) -> Vec<Vec<f32>> {
+/// The model's output planes for `lf` as it is.
+fn run_once(
+    net: &EpiNet,
+    model: ModelKind,
+    input: &StackInput,
+    lf: &LightField,
+    shift: f32,
+    device: &Device,
+) -> Vec<Vec<f32>> {
     let region = Region::whole(lf);
-    let shape = [1, lf.n * 3, lf.height, lf.width];
-    let stacks = Direction::ALL.map(|dir| tensor4(extract(lf, dir, region, shift), shape, device));
-    let out = values(net.forward(stacks));
+    let shape = [1, input.channels(lf.n), lf.height, lf.width];
+    let planes = |dir| input.planes(lf, dir, region, shift, |_| ());
+    let stacks = Direction::ALL.map(|dir| tensor4(planes(dir), shape, device));
+    let out = values(decode(net.forward(stacks), model, input));
     out.chunks_exact(lf.width * lf.height)
         .map(<[f32]>::to_vec)
         .collect()
@@ -108,24 +120,33 @@ fn predict_epinet(
 ) -> ScenePrediction {
     let start = Instant::now();
     let (w, h) = (lf.width, lf.height);
+    let input = StackInput::of(cfg);
+    let run = |shift| {
+        run_net(
+            net,
+            cfg.model,
+            &input,
+            lf,
+            shift,
+            cfg.test_rotations,
+            device,
+        )
+    };
     let posterior = match cfg.model {
         ModelKind::Base => None,
         ModelKind::Upr => {
-            let mut out = run_net(net, lf, 0.0, cfg.test_rotations, device);
+            let mut out = run(0.0);
             let log_b = out.swap_remove(1);
             let mu = out.swap_remove(0);
             Some(PosteriorForm::Laplace { mu, log_b })
         }
-        ModelKind::Ese => Some(ese_mixture(cfg, net, lf, device)),
-        ModelKind::Dpp => Some(dpp_posterior(
-            cfg,
-            run_net(net, lf, 0.0, cfg.test_rotations, device),
-        )),
+        ModelKind::Ese => Some(ese_mixture(cfg, lf, run)),
+        ModelKind::Dpp => Some(dpp_posterior(cfg, run(0.0))),
         ModelKind::EpiShift => unreachable!("EPI-Shift runs its own network"),
     };
     let (disparity, posterior) = match posterior {
         None => {
-            let out = run_net(net, lf, 0.0, cfg.test_rotations, device);
+            let out = run(0.0);
             (FloatImage::new(w, h, out[0].clone()), None)
         }
         Some(form) => {
@@ -159,13 +180,17 @@ fn predict_epinet(
 
 /// The ESE mixture (thesis eq. 5.9): pass `k` on the light field shifted by `s_k` predicts
 /// `d - s_k`, so its Laplacian is centred at `μ_k + s_k`; all passes weigh `1/M`.
-fn ese_mixture(cfg: &TrainConfig, net: &EpiNet, lf: &LightField, device: &Device) -> PosteriorForm {
+fn ese_mixture(
+    cfg: &TrainConfig,
+    lf: &LightField,
+    run: impl Fn(f32) -> Vec<Vec<f32>>,
+) -> PosteriorForm {
     let shifts = cfg.ese.scene_shifts(lf.disparity_range);
     let m = shifts.len();
     let pixels = lf.width * lf.height;
     let (mut mu, mut log_b) = (vec![0.0; pixels * m], vec![0.0; pixels * m]);
     for (k, &s) in shifts.iter().enumerate() {
-        let out = run_net(net, lf, s, cfg.test_rotations, device);
+        let out = run(s);
         for i in 0..pixels {
             mu[i * m + k] = out[0][i] + s;
             log_b[i * m + k] = out[1][i];
@@ -196,9 +221,10 @@ fn dpp_posterior(cfg: &TrainConfig, planes: Vec<Vec<f32>>) -> PosteriorForm {
         let sum: f32 = px.iter().sum();
         px.iter_mut().for_each(|q| *q /= sum);
     }
-    let bins = Bins::new(cfg.dpp.min as f64, cfg.dpp.max as f64, cfg.dpp.bins)
-        .expect("validated DPP bins");
-    PosteriorForm::Discrete { bins, probs }
+    PosteriorForm::Discrete {
+        bins: cfg.dpp.bins(),
+        probs,
+    }
 }
 
 /// The most likely mode of one pixel's discrete posterior `probs` over `bins` at a scale of

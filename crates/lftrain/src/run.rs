@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::config::{ModelKind, TrainConfig};
 use crate::epishift::EpiShiftNet;
+use crate::input::StackInput;
 use crate::model::{EpiNet, Network};
 
 /// The config of a run, as written at its start.
@@ -120,8 +121,8 @@ pub fn build_net(cfg: &TrainConfig, grid: usize, device: &Device) -> Network {
         ModelKind::EpiShift => Network::Shift(EpiShiftNet::new(&cfg.epishift, grid * 3, device)),
         _ => Network::Epi(EpiNet::new(
             &cfg.net,
-            grid * 3,
-            cfg.model.out_channels(cfg.dpp.bins),
+            StackInput::of(cfg).channels(grid),
+            cfg.model.net_channels(cfg.net.input, cfg.dpp.bins),
             device,
         )),
     }

@@ -5,10 +5,11 @@ use rand::{Rng, RngExt};
 
 use crate::augment::Photometric;
 use crate::config::AugmentConfig;
+use crate::input::StackInput;
 use crate::lightfield::{crop_plane, rotate_plane};
 use crate::mask::inside_border;
 use crate::scene::{Scene, Targets};
-use crate::stacks::{Direction, Region, extract};
+use crate::stacks::{Direction, Region};
 
 /// The random choices of one sample, drawn first so that a sample is a pure function of them.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -80,16 +81,23 @@ pub struct Sample {
     pub loss_pixels: usize,
 }
 
-/// The sample of `scene` for `draw`.
+/// The sample of `scene` for `draw`, with `input` as the stacks' content.
 ///
-/// The crop is taken with a margin wide enough for the EPI shift of the outer views, so the
+/// The crop is taken with a margin wide enough for the EPI shift of the outer views (and
+/// the cost volume's furthest hypothesis), so the
 /// shifted stacks read real pixels wherever the scene has them, then rotated (views, view grid
 /// and targets together), then the stacks are extracted with the shift. The loss region leaves
 /// out `border` pixels at each crop edge and the scene's flat pixels ([`Scene::texture`],
 /// cropped and rotated with the views).
-pub fn make_sample(scene: &Scene, draw: &Draw, patch: usize, border: usize) -> Sample {
+pub fn make_sample(
+    scene: &Scene,
+    draw: &Draw,
+    patch: usize,
+    border: usize,
+    input: &StackInput,
+) -> Sample {
     let c = scene.lf.centre() as f32;
-    let margin = (c * draw.shift.abs()).ceil() as usize + 1;
+    let margin = (c * (draw.shift.abs() + input.reach())).ceil() as usize + 1;
     let (x0, y0) = (draw.origin.0 as isize, draw.origin.1 as isize);
     let (m, k) = (margin as isize, draw.scale.max(1));
     let side = patch + 2 * margin;
@@ -113,11 +121,8 @@ pub fn make_sample(scene: &Scene, draw: &Draw, patch: usize, border: usize) -> S
         1,
     );
     let pivot = draw.photometric.pivot(&centre);
-    let stacks = Direction::ALL.map(|dir| {
-        let mut s = extract(&lf, dir, region, draw.shift);
-        draw.photometric.apply(&mut s, patch * patch, pivot);
-        s
-    });
+    let photometric = |s: &mut [f32]| draw.photometric.apply(s, patch * patch, pivot);
+    let stacks = Direction::ALL.map(|dir| input.planes(&lf, dir, region, draw.shift, photometric));
     let (disparity, mut eta) = target_planes(&scene.targets, (x0, y0), patch, draw);
     let region = loss_region(scene, (x0, y0), patch, draw, border);
     for slot in eta.chunks_exact_mut(patch * patch) {

@@ -83,16 +83,21 @@ impl Region {
 /// disparity `d` has disparity `d - s` in the shifted light field: it lies at `x - du d` in
 /// view `du`, and `x' - du s = x - du d` gives `x' = x - du (d - s)`.
 pub fn extract(lf: &LightField, dir: Direction, region: Region, shift: f32) -> Vec<f32> {
+    let mut out = vec![0.0; lf.n * 3 * region.width * region.height];
+    extract_into(lf, dir, region, shift, &mut out);
+    out
+}
+
+/// [`extract`] into `out` (`n * 3` planes of the region), for callers that refill one buffer.
+pub fn extract_into(lf: &LightField, dir: Direction, region: Region, shift: f32, out: &mut [f32]) {
     let c = lf.centre() as f32;
     let plane = region.width * region.height;
-    let mut out = vec![0.0; lf.n * 3 * plane];
     for (k, (u, v)) in dir.positions(lf.n).into_iter().enumerate() {
         let view = lf.view(u, v);
         let (ox, oy) = (-(u as f32 - c) * shift, -(v as f32 - c) * shift);
         let planes = &mut out[k * 3 * plane..(k + 1) * 3 * plane];
         sample_shifted(view, lf.width, lf.height, region, (ox, oy), planes);
     }
-    out
 }
 
 /// Bilinear samples of the RGB image `rgb` at `(x + ox, y + oy)` for every pixel of `region`

@@ -11,10 +11,11 @@ use indicatif::{ProgressBar, ProgressStyle};
 use lfformat::dataset::discover;
 
 use crate::config::{ModelKind, TrainConfig};
+use crate::input::StackInput;
 use crate::loader::{Loader, PoolConfig, TrainBatch};
 use crate::log::{Record, TrainLog};
 use crate::loss::loss;
-use crate::model::Network;
+use crate::model::{Network, decode};
 use crate::run::{CONFIG_FILE, RunDir, RunState, build_net, grid_of};
 use crate::shift_loss::{ShiftTargets, epishift_loss};
 use crate::shift_sample::ShiftBatch;
@@ -220,7 +221,8 @@ impl Trainer {
     fn loss(&self, batch: &TrainBatch) -> Result<Tensor<1>> {
         Ok(match (&self.net, batch) {
             (Network::Epi(net), TrainBatch::Stacks(b)) => {
-                let out = net.forward(stack_tensors(b, &self.device));
+                let raw = net.forward(stack_tensors(b, &self.device));
+                let out = decode(raw, self.cfg.model, &StackInput::of(&self.cfg));
                 loss(&self.cfg, out, &target_tensors(b, &self.cfg, &self.device))
             }
             (Network::Shift(net), TrainBatch::Shifts(b)) => {
@@ -310,12 +312,13 @@ pub fn bench_steps(cfg: &TrainConfig, grid: usize, steps: usize) -> Result<(f64,
             loss_pixels: plane,
         })
     } else {
+        let channels = StackInput::of(cfg).channels(grid);
         TrainBatch::Stacks(crate::sample::Batch {
             size: b,
             patch: p,
-            stack_channels: grid * 3,
+            stack_channels: channels,
             modes,
-            stacks: std::array::from_fn(|_| noise(plane * grid * 3, 1.0)),
+            stacks: std::array::from_fn(|_| noise(plane * channels, 1.0)),
             disparity: noise(plane * modes, 6.0),
             eta: vec![1.0 / modes as f32; plane * modes],
             loss_pixels: plane,

@@ -3,6 +3,7 @@
 
 use lftrain::augment::Photometric;
 use lftrain::config::AugmentConfig;
+use lftrain::input::StackInput;
 use lftrain::lightfield::{LightField, rotate_plane};
 use lftrain::sample::{Draw, make_sample};
 use lftrain::scene::Scene;
@@ -70,8 +71,8 @@ fn rotated_samples_match_samples_of_the_rendered_rotation() {
             photometric: Photometric::IDENTITY,
         };
         // The whole image as the crop: rotating it is rotating the scene.
-        let a = make_sample(&original, &draw(turns), 20, 0);
-        let b = make_sample(&load(turns), &draw(0), 20, 0);
+        let a = make_sample(&original, &draw(turns), 20, 0, &StackInput::Views);
+        let b = make_sample(&load(turns), &draw(0), 20, 0, &StackInput::Views);
         for k in 0..4 {
             // 8-bit views: the rotated scene's PNG rounds the same colours.
             let diff = max_diff(&a.stacks[k], &b.stacks[k]);
@@ -82,8 +83,8 @@ fn rotated_samples_match_samples_of_the_rendered_rotation() {
         // The loss region turns with the views: the texture mask of the rotated crop is the
         // mask of the rotated scene (mmlf forgets this), and the border is the same square.
         let masked = |s: Scene| s.with_texture_mask(5, 0.12);
-        let a = make_sample(&masked(load(0)), &draw(turns), 20, 3);
-        let b = make_sample(&masked(load(turns)), &draw(0), 20, 3);
+        let a = make_sample(&masked(load(0)), &draw(turns), 20, 3, &StackInput::Views);
+        let b = make_sample(&masked(load(turns)), &draw(0), 20, 3, &StackInput::Views);
         assert_eq!(a.eta, b.eta, "{turns} turns: loss region");
         assert_eq!(a.loss_pixels, b.loss_pixels);
         let inner = 14 * 14;
@@ -135,12 +136,12 @@ fn shifting_by_the_disparity_aligns_the_views_and_zeroes_the_target() {
         shift: d,
         photometric: Photometric::IDENTITY,
     };
-    let sample = make_sample(&scene, &draw, 16, 0);
+    let sample = make_sample(&scene, &draw, 16, 0, &StackInput::Views);
     assert!(sample.disparity.iter().all(|t| t.abs() < 1e-6));
     assert!(sample.eta.iter().all(|&e| e == 1.0));
     assert_eq!(sample.loss_pixels, 256);
     // A 4 px loss border keeps the inner 8 × 8 pixels, and only them.
-    let sample = make_sample(&scene, &draw, 16, 4);
+    let sample = make_sample(&scene, &draw, 16, 4, &StackInput::Views);
     assert_eq!(sample.loss_pixels, 64);
     for (i, &e) in sample.eta.iter().enumerate() {
         let inner = (4..12).contains(&(i % 16)) && (4..12).contains(&(i / 16));
@@ -169,7 +170,7 @@ fn downscaling_halves_the_disparity_of_views_and_targets() {
         shift,
         photometric: Photometric::IDENTITY,
     };
-    let sample = make_sample(&scene, &draw(d / 2.0), 8, 0);
+    let sample = make_sample(&scene, &draw(d / 2.0), 8, 0, &StackInput::Views);
     assert!(
         sample.disparity.iter().all(|t| t.abs() < 1e-6),
         "{:?}",
@@ -184,7 +185,7 @@ fn downscaling_halves_the_disparity_of_views_and_targets() {
         }
     }
     // Shifted by the full-resolution disparity instead, the views disagree.
-    let wrong = make_sample(&scene, &draw(d), 8, 0);
+    let wrong = make_sample(&scene, &draw(d), 8, 0, &StackInput::Views);
     assert!(max_diff(&wrong.stacks[0][..len], &wrong.stacks[0][2 * len..3 * len]) > 0.1);
 }
 

@@ -4,7 +4,7 @@
 
 use burn::prelude::*;
 use burn::tensor::TensorData;
-use lftrain::config::{EseOutside, ModelKind, NetConfig, TrainConfig};
+use lftrain::config::{EseOutside, ModelKind, NetConfig, NetInput, TrainConfig};
 use lftrain::loss::{TargetTensors, dpp_bin, loss};
 use lftrain::model::{EpiNet, turn_to_reference};
 use lftrain::stacks::{Direction, Region, extract};
@@ -117,6 +117,7 @@ fn tiny_net() -> NetConfig {
         stream_blocks: 1,
         head_width: 8,
         head_blocks: 1,
+        input: NetInput::Views,
     }
 }
 
@@ -206,8 +207,17 @@ fn train_args(
     lftrain::train::TrainArgs::quiet(train, val, out, pool)
 }
 
-#[test]
-fn tiny_model_overfits_tiny_dataset_then_predicts_for_lfeval() {
+/// Validation MSE×100 and BadPix(0.07) of the first and last records, and the mean loss of
+/// the first and last five steps.
+struct Overfit {
+    loss: (f64, f64),
+    mse: (f64, f64),
+    badpix: (f64, f64),
+}
+
+/// Trains a tiny BASE on the whole of a tiny two-plane pair for 400 steps with `input`, and
+/// checks the run folder and that its checkpoint predicts in lfeval's format.
+fn overfit(input: NetInput) -> Overfit {
     use lftrain::train::train;
 
     let tmp = tempfile::tempdir().unwrap();
@@ -227,6 +237,7 @@ fn tiny_model_overfits_tiny_dataset_then_predicts_for_lfeval() {
             stream_blocks: 2,
             head_width: 16,
             head_blocks: 2,
+            input,
         },
         // Capacity, not the recipe: every pixel of the whole 24² scene trained at full rate
         // (validation scores all of it).
@@ -235,6 +246,8 @@ fn tiny_model_overfits_tiny_dataset_then_predicts_for_lfeval() {
         texture_threshold: 0.0,
         ..TrainConfig::default()
     };
+    // The cost volume's hypotheses: 16 bins over the pair's ±1.25 px and a margin.
+    (cfg.dpp.bins, cfg.dpp.min, cfg.dpp.max) = (16, -1.5, 1.5);
     cfg.augment.max_shift = 0.0;
     cfg.augment.rotate = false;
     cfg.augment.colour = lftrain::config::ColourAugment::Off;
@@ -246,21 +259,24 @@ fn tiny_model_overfits_tiny_dataset_then_predicts_for_lfeval() {
     let r = &summary.records;
     let mean_loss =
         |rs: &[lftrain::log::Record]| rs.iter().map(|r| r.loss).sum::<f64>() / rs.len() as f64;
-    let (first, last) = (mean_loss(&r[..5]), mean_loss(&r[r.len() - 5..]));
     let badpix = |r: &lftrain::log::Record| r.val_badpix_007.unwrap();
     let mse = |r: &lftrain::log::Record| r.val_mse_x100.unwrap();
+    let last = r.last().unwrap();
+    let o = Overfit {
+        loss: (mean_loss(&r[..5]), mean_loss(&r[r.len() - 5..])),
+        mse: (mse(&r[0]), mse(last)),
+        badpix: (badpix(&r[0]), badpix(last)),
+    };
     eprintln!(
-        "overfit: {:.1} s, loss {first:.4} → {last:.4}, MSE×100 {:.2} → {:.2}, BadPix(0.07) {:.1} → {:.1}",
+        "overfit {input:?}: {:.1} s, loss {:.4} → {:.4}, MSE×100 {:.2} → {:.2}, BadPix(0.07) {:.1} → {:.1}",
         t0.elapsed().as_secs_f64(),
-        mse(&r[0]),
-        mse(r.last().unwrap()),
-        badpix(&r[0]),
-        badpix(r.last().unwrap())
+        o.loss.0,
+        o.loss.1,
+        o.mse.0,
+        o.mse.1,
+        o.badpix.0,
+        o.badpix.1
     );
-    // Measured: loss ÷8, MSE×100 ÷17 (98.9 → 5.6), BadPix(0.07) 100 → 60 in ~14 s.
-    assert!(last < first / 5.0, "loss {first} → {last}");
-    assert!(mse(r.last().unwrap()) < mse(&r[0]) / 10.0);
-    assert!(badpix(r.last().unwrap()) < badpix(&r[0]) * 0.75);
     for f in [
         "config.toml",
         "log.csv",
@@ -278,6 +294,25 @@ fn tiny_model_overfits_tiny_dataset_then_predicts_for_lfeval() {
     let method = lfeval::prediction::Method::new(&pred).unwrap();
     let loaded = method.load("a", 24, 24).unwrap();
     assert!(loaded.disparity.data.iter().all(|d| d.is_finite()));
+    o
+}
+
+#[test]
+fn tiny_model_overfits_tiny_dataset_then_predicts_for_lfeval() {
+    let o = overfit(NetInput::Views);
+    // Measured: loss ÷8, MSE×100 ÷17 (98.9 → 5.6), BadPix(0.07) 100 → 60 in ~14 s.
+    assert!(o.loss.1 < o.loss.0 / 5.0, "loss {:?}", o.loss);
+    assert!(o.mse.1 < o.mse.0 / 10.0, "MSE {:?}", o.mse);
+    assert!(o.badpix.1 < o.badpix.0 * 0.75, "BadPix {:?}", o.badpix);
+}
+
+#[test]
+fn a_cost_volume_model_learns_sub_hypothesis_disparities() {
+    let o = overfit(NetInput::Cost);
+    // The hypotheses are 0.19 px apart: below 0.07 px at most pixels needs the soft argmin
+    // to interpolate between them.
+    assert!(o.mse.1 < o.mse.0 / 10.0, "MSE {:?}", o.mse);
+    assert!(o.badpix.1 < 30.0, "BadPix {:?}", o.badpix);
 }
 
 #[test]
@@ -285,35 +320,48 @@ fn every_model_writes_a_posterior_lfeval_reads() {
     let dev = device();
     let lf = TwoPlanes::new(3, 10).render();
     let tmp = tempfile::tempdir().unwrap();
-    for (model, form, components) in [
+    for ((model, form, components), input) in [
         (ModelKind::Base, "point", 0),
         (ModelKind::Upr, "laplace", 1),
         (ModelKind::Ese, "mixture", 7),
         (ModelKind::Dpp, "discrete", 108),
-    ] {
+    ]
+    .into_iter()
+    .flat_map(|m| [(m, NetInput::Views), (m, NetInput::Cost)])
+    {
         let c = TrainConfig {
             model,
-            net: tiny_net(),
+            net: NetConfig {
+                input,
+                ..tiny_net()
+            },
             ..TrainConfig::default()
         };
-        let net = lftrain::model::Network::Epi(EpiNet::new(
-            &c.net,
-            9,
-            model.out_channels(c.dpp.bins),
-            &dev,
-        ));
+        let net = lftrain::run::build_net(&c, 3, &dev);
         let pred = lftrain::predict::predict(&c, &net, &lf, &dev);
         if matches!(model, ModelKind::Dpp | ModelKind::Ese) {
             point_follows_the_config(c.clone(), &net, &lf, &dev);
         }
-        let dir = tmp.path().join(model.name());
+        let dir = tmp.path().join(format!("{}_{input:?}", model.name()));
         lfeval::prediction::write_prediction(&dir, "s", &pred).unwrap();
         let back = lfeval::prediction::Method::new(&dir)
             .unwrap()
             .load("s", 10, 10)
             .unwrap();
         let name = back.posterior.as_ref().map_or("point", |p| p.form_name());
-        assert_eq!(name, form, "{model:?}");
+        assert_eq!(name, form, "{model:?} on {input:?}");
+        if input == NetInput::Cost && model != ModelKind::Dpp {
+            // A soft argmin cannot leave the hypotheses' range, even untrained.
+            let (lo, hi) = (c.dpp.min, c.dpp.max);
+            let inside = |d: &f32| (lo..=hi).contains(d);
+            match back.posterior.as_ref().map(|p| &p.form) {
+                Some(lfeval::posterior::PosteriorForm::Laplace { mu, .. }) => {
+                    assert!(mu.iter().all(inside))
+                }
+                None => assert!(back.disparity.data.iter().all(inside)),
+                _ => {}
+            }
+        }
         if let Some(lfeval::posterior::PosteriorForm::Mixture {
             components: m, mu, ..
         }) = back.posterior.map(|p| p.form)
@@ -392,6 +440,7 @@ fn a_patch_larger_than_the_scenes_is_refused_naming_the_scene() {
 
 #[test]
 fn test_rotations_turn_the_prediction_with_the_light_field() {
+    use lftrain::input::StackInput;
     use lftrain::lightfield::{LightField, rotate_plane};
     use lftrain::predict::run_net;
     let dev = device();
@@ -413,8 +462,24 @@ fn test_rotations_turn_the_prediction_with_the_light_field() {
     // The largest |difference| between the output for the turned light field and the
     // turned output, and the largest spread of an output plane.
     let gap_and_spread = |rotations: usize| {
-        let plain = run_net(&net, &lf, 0.0, rotations, &dev);
-        let of_turned = run_net(&net, &turned, 0.0, rotations, &dev);
+        let plain = run_net(
+            &net,
+            ModelKind::Dpp,
+            &StackInput::Views,
+            &lf,
+            0.0,
+            rotations,
+            &dev,
+        );
+        let of_turned = run_net(
+            &net,
+            ModelKind::Dpp,
+            &StackInput::Views,
+            &turned,
+            0.0,
+            rotations,
+            &dev,
+        );
         let (mut gap, mut spread) = (0.0f32, 0.0f32);
         for (p, t) in plain.iter().zip(&of_turned) {
             let expected = rotate_plane(p, w, h, 1);
@@ -462,4 +527,36 @@ fn point_follows_the_config(
         differs |= d != pixel.point_estimate() as f32;
     }
     assert!(differs, "{:?}: the option changed no pixel", c.model);
+}
+
+#[test]
+fn decode_takes_the_soft_argmin_of_the_hypotheses() {
+    use lftrain::input::StackInput;
+    use lftrain::model::decode;
+    let dev = device();
+    let input = StackInput::Cost(vec![-1.0, 0.0, 2.0]);
+    // Pixel 0: logits (0, 0, 0), weights ⅓ each: (−1 + 0 + 2) / 3 = ⅓. Pixel 1: logits
+    // (0, ln 2, 0), weights (¼, ½, ¼): −¼ + 0 + ½ = ¼. Channel 3 is log b: 0.5 and −1.
+    let l2 = 2f32.ln();
+    let raw = tensor4(
+        vec![0.0, 0.0, 0.0, l2, 0.0, 0.0, 0.5, -1.0],
+        [1, 4, 1, 2],
+        &dev,
+    );
+    let base = values(decode(raw.clone().narrow(1, 0, 3), ModelKind::Base, &input));
+    assert!(
+        (base[0] - 1.0 / 3.0).abs() < 1e-6 && (base[1] - 0.25).abs() < 1e-6,
+        "{base:?}"
+    );
+    let upr = values(decode(raw.clone(), ModelKind::Upr, &input));
+    assert_eq!(upr.len(), 4);
+    assert!((upr[1] - 0.25).abs() < 1e-6);
+    assert_eq!(&upr[2..], &[0.5, -1.0]);
+    // DPP's logits and every model on views pass through unchanged.
+    let same = values(raw.clone());
+    assert_eq!(values(decode(raw.clone(), ModelKind::Dpp, &input)), same);
+    assert_eq!(
+        values(decode(raw, ModelKind::Upr, &StackInput::Views)),
+        same
+    );
 }
