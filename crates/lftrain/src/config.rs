@@ -86,6 +86,23 @@ pub struct NetConfig {
     pub head_blocks: usize,
     /// What each of the four input streams reads (the thesis: the stack's views).
     pub input: NetInput,
+    /// The network on cost volumes: this EPINET on the hypotheses as channels, or the shared
+    /// per-hypothesis aggregation of [`crate::costnet`] (whose sizes are the next two).
+    pub cost_network: CostNetwork,
+    /// Channels of the per-hypothesis net's blocks.
+    pub cost_width: usize,
+    /// Blocks of the per-hypothesis net (its receptive radius is `cost_blocks + 1`).
+    pub cost_blocks: usize,
+}
+
+/// The network that reads cost volumes ([`NetInput::Cost`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CostNetwork {
+    /// The EPINET streams and head, the hypotheses as channels.
+    Streams,
+    /// [`crate::costnet::CostNet`]: one small net shared by every hypothesis.
+    PerHypothesis,
 }
 
 /// The network's input per stack direction.
@@ -109,7 +126,10 @@ impl NetConfig {
     /// convolutions widen the field by one pixel per side, over the stream blocks, the head
     /// blocks and the final block (the thesis net: 3 + 7 + 1 = 11, a 23 px field).
     pub fn receptive_radius(&self) -> usize {
-        self.stream_blocks + self.head_blocks + 1
+        match (self.input, self.cost_network) {
+            (NetInput::Cost, CostNetwork::PerHypothesis) => self.cost_blocks + 1,
+            _ => self.stream_blocks + self.head_blocks + 1,
+        }
     }
 }
 
@@ -121,6 +141,9 @@ impl Default for NetConfig {
             head_width: 280,
             head_blocks: 7,
             input: NetInput::Views,
+            cost_network: CostNetwork::Streams,
+            cost_width: 8,
+            cost_blocks: 5,
         }
     }
 }
@@ -663,6 +686,9 @@ impl TrainConfig {
         if self.dpp.bins < 2 || self.dpp.max <= self.dpp.min {
             bail!("dpp needs ≥ 2 bins over a non-empty range");
         }
+        if self.net.cost_width == 0 || self.net.cost_blocks == 0 {
+            bail!("net.cost_width and net.cost_blocks must be ≥ 1");
+        }
         if self.net.input == NetInput::Cost && self.model == ModelKind::EpiShift {
             bail!("net.input = \"cost\" is for BASE, UPR, ESE and DPP; EPI-Shift reads views");
         }
@@ -876,28 +902,33 @@ mod tests {
         );
     }
 
-    /// The cost recipe is the field recipe's schedule on a cost volume: 48 hypotheses over
-    /// ±3.5 px, a smaller net, no EPI shift (the targets must stay inside the hypotheses).
+    /// The cost recipe: the per-hypothesis net on 60 hypotheses over ±4.5 px, radius 4 px
+    /// (the baseline's 9×9 window), no EPI shift (the targets must stay inside the
+    /// hypotheses), the field recipe's schedule scaled to 2 000 steps.
     #[test]
     fn the_cost_recipe_reads_cost_volumes_and_refuses_epishift() {
-        let field: TrainConfig = toml::from_str(include_str!("../configs/cpu_field.toml")).unwrap();
         let cost: TrainConfig = toml::from_str(include_str!("../configs/cpu_cost.toml")).unwrap();
         cost.validate().unwrap();
         assert_eq!(cost.net.input, NetInput::Cost);
-        assert_eq!((cost.dpp.bins, cost.dpp.min, cost.dpp.max), (48, -3.5, 3.5));
+        assert_eq!(cost.net.cost_network, CostNetwork::PerHypothesis);
+        assert_eq!((cost.dpp.bins, cost.dpp.min, cost.dpp.max), (60, -4.5, 4.5));
         assert_eq!(cost.augment.max_shift, 0.0);
-        assert_eq!(cost.net.receptive_radius(), 9);
+        assert_eq!(cost.net.receptive_radius(), 4);
         assert_eq!(
-            (cost.steps, cost.warmup_steps, cost.learning_rate),
-            (field.steps, field.warmup_steps, field.learning_rate)
+            (
+                cost.steps,
+                cost.warmup_steps,
+                cost.lr_decay_steps.as_slice()
+            ),
+            (2000, 500, &[1500][..])
         );
         assert_eq!(TrainConfig::default().net.input, NetInput::Views);
         // One logit per hypothesis, and log b for UPR and ESE.
-        let channels = |m: ModelKind| m.net_channels(NetInput::Cost, 48);
-        assert_eq!(channels(ModelKind::Base), 48);
-        assert_eq!(channels(ModelKind::Upr), 49);
-        assert_eq!(channels(ModelKind::Ese), 49);
-        assert_eq!(channels(ModelKind::Dpp), 48);
+        let channels = |m: ModelKind| m.net_channels(NetInput::Cost, 60);
+        assert_eq!(channels(ModelKind::Base), 60);
+        assert_eq!(channels(ModelKind::Upr), 61);
+        assert_eq!(channels(ModelKind::Ese), 61);
+        assert_eq!(channels(ModelKind::Dpp), 60);
         assert_eq!(ModelKind::Upr.net_channels(NetInput::Views, 48), 2);
         let shift = TrainConfig {
             model: ModelKind::EpiShift,

@@ -9,12 +9,13 @@ use burn::tensor::TensorData;
 use burn::tensor::activation::{relu, softmax};
 
 use crate::config::{ModelKind, NetConfig};
+use crate::costnet::CostNet;
 use crate::epishift::EpiShiftNet;
 use crate::input::StackInput;
 
 /// A 2×2 convolution; `grow` pads by one on every side (size + 1), otherwise none (size − 1):
 /// the thesis alternates the two so that every block keeps the image size.
-fn conv2x2(cin: usize, cout: usize, grow: bool, device: &Device) -> Conv2d {
+pub(crate) fn conv2x2(cin: usize, cout: usize, grow: bool, device: &Device) -> Conv2d {
     let padding = if grow {
         PaddingConfig2d::Explicit(1, 1, 1, 1)
     } else {
@@ -59,12 +60,12 @@ impl Block {
 }
 
 /// A chain of blocks.
-fn chain(blocks: &[Block], x: Tensor<4>) -> Tensor<4> {
+pub(crate) fn chain(blocks: &[Block], x: Tensor<4>) -> Tensor<4> {
     blocks.iter().fold(x, |x, b| b.forward(x))
 }
 
 /// `count` blocks, the first from `cin`, all to `width`.
-fn blocks(cin: usize, width: usize, count: usize, device: &Device) -> Vec<Block> {
+pub(crate) fn blocks(cin: usize, width: usize, count: usize, device: &Device) -> Vec<Block> {
     (0..count)
         .map(|i| Block::new(if i == 0 { cin } else { width }, width, device))
         .collect()
@@ -145,6 +146,18 @@ impl EpiNet {
     }
 }
 
+/// A network on the four stacks (views or cost volumes), as prediction runs it.
+pub trait StackNet {
+    /// Raw outputs `[B, C, H, W]` for the stacks `[0°, 90°, 45°, −45°]`.
+    fn forward(&self, stacks: [Tensor<4>; 4]) -> Tensor<4>;
+}
+
+impl StackNet for EpiNet {
+    fn forward(&self, stacks: [Tensor<4>; 4]) -> Tensor<4> {
+        EpiNet::forward(self, stacks)
+    }
+}
+
 /// The model's outputs (what [`crate::loss`] and [`crate::predict`] read) from the network's
 /// raw ones `[B, C, H, W]`: the same on views; on a cost volume, BASE's disparity and UPR's and
 /// ESE's `μ` are the softmax-weighted mean of the hypotheses over the first `K` channels (a
@@ -169,7 +182,9 @@ pub fn decode(raw: Tensor<4>, model: ModelKind, input: &StackInput) -> Tensor<4>
     }
 }
 
-/// The network of a run: EPINET's for BASE, UPR, ESE and DPP, EPI-Shift's for EPI-Shift.
+/// The network of a run: EPINET's for BASE, UPR, ESE and DPP (on views, or on cost volumes
+/// with `cost_network = "streams"`), the per-hypothesis [`CostNet`] on cost volumes, EPI-Shift's
+/// for EPI-Shift.
 // One network per run, moved rarely: the size difference does not matter, and burn's Module
 // derive does not see through a Box.
 #[allow(clippy::large_enum_variant)]
@@ -177,6 +192,8 @@ pub fn decode(raw: Tensor<4>, model: ModelKind, input: &StackInput) -> Tensor<4>
 pub enum Network {
     /// Appendix B.1.
     Epi(EpiNet),
+    /// Shared per-hypothesis cost aggregation.
+    Cost(CostNet),
     /// Thesis §4.2.3.
     Shift(EpiShiftNet),
 }
@@ -186,6 +203,7 @@ impl Network {
     pub fn freeze_batch_norm(self) -> Self {
         match self {
             Network::Epi(n) => Network::Epi(n.freeze_batch_norm()),
+            Network::Cost(n) => Network::Cost(n.freeze_batch_norm()),
             Network::Shift(n) => Network::Shift(n.freeze_batch_norm()),
         }
     }

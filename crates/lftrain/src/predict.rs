@@ -14,7 +14,7 @@ use crate::config::{EsePoint, ModelKind, TrainConfig};
 use crate::epishift::EpiShiftNet;
 use crate::input::StackInput;
 use crate::lightfield::{LightField, rotate_plane};
-use crate::model::{EpiNet, Network, decode};
+use crate::model::{Network, StackNet, decode};
 use crate::shift_predict::estimate;
 use crate::stacks::{Direction, Region};
 use crate::tensors::{tensor4, values};
@@ -26,7 +26,7 @@ use crate::tensors::{tensor4, values};
 /// `net` must be in validation mode on a device without autodiff (batch norm then uses its
 /// running statistics).
 pub fn run_net(
-    net: &EpiNet,
+    net: &impl StackNet,
     model: ModelKind,
     input: &StackInput,
     lf: &LightField,
@@ -51,7 +51,7 @@ pub fn run_net(
 
 /// The model's output planes for `lf` as it is.
 fn run_once(
-    net: &EpiNet,
+    net: &impl StackNet,
     model: ModelKind,
     input: &StackInput,
     lf: &LightField,
@@ -85,7 +85,8 @@ pub fn predict(
     device: &Device,
 ) -> ScenePrediction {
     match net {
-        Network::Epi(n) => predict_epinet(cfg, n, lf, device),
+        Network::Epi(n) => predict_stacks(cfg, n, lf, device),
+        Network::Cost(n) => predict_stacks(cfg, n, lf, device),
         Network::Shift(n) => predict_epishift(cfg, n, lf, device),
     }
 }
@@ -112,9 +113,9 @@ pub fn predict_epishift(
     }
 }
 
-fn predict_epinet(
+fn predict_stacks(
     cfg: &TrainConfig,
-    net: &EpiNet,
+    net: &impl StackNet,
     lf: &LightField,
     device: &Device,
 ) -> ScenePrediction {

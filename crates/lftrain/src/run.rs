@@ -9,7 +9,8 @@ use lfformat::HciParameters;
 use lfformat::dataset::{PARAMETERS_FILE, SceneDir};
 use serde::{Deserialize, Serialize};
 
-use crate::config::{ModelKind, TrainConfig};
+use crate::config::{CostNetwork, ModelKind, NetInput, TrainConfig};
+use crate::costnet::CostNet;
 use crate::epishift::EpiShiftNet;
 use crate::input::StackInput;
 use crate::model::{EpiNet, Network};
@@ -84,6 +85,7 @@ impl RunDir {
         // The inner network is stored, so that checkpoints of EPINET runs keep their layout.
         match net.clone() {
             Network::Epi(n) => n.save_file(&path),
+            Network::Cost(n) => n.save_file(&path),
             Network::Shift(n) => n.save_file(&path),
         }
         .map_err(|e| anyhow::anyhow!("{}: cannot write: {e:?}", path.display()))?;
@@ -102,6 +104,7 @@ impl RunDir {
         let err = |e| anyhow::anyhow!("{}: cannot load weights: {e:?}", path.display());
         Ok(match build_net(cfg, grid, device) {
             Network::Epi(n) => Network::Epi(n.try_load_file(&path).map_err(err)?),
+            Network::Cost(n) => Network::Cost(n.try_load_file(&path).map_err(err)?),
             Network::Shift(n) => Network::Shift(n.try_load_file(&path).map_err(err)?),
         })
     }
@@ -119,6 +122,12 @@ impl RunDir {
 pub fn build_net(cfg: &TrainConfig, grid: usize, device: &Device) -> Network {
     match cfg.model {
         ModelKind::EpiShift => Network::Shift(EpiShiftNet::new(&cfg.epishift, grid * 3, device)),
+        _ if cfg.net.input == NetInput::Cost
+            && cfg.net.cost_network == CostNetwork::PerHypothesis =>
+        {
+            let spread = matches!(cfg.model, ModelKind::Upr | ModelKind::Ese);
+            Network::Cost(CostNet::new(&cfg.net, cfg.dpp.bins, spread, device))
+        }
         _ => Network::Epi(EpiNet::new(
             &cfg.net,
             StackInput::of(cfg).channels(grid),

@@ -15,8 +15,9 @@ use crate::input::StackInput;
 use crate::loader::{Loader, PoolConfig, TrainBatch};
 use crate::log::{Record, TrainLog};
 use crate::loss::loss;
-use crate::model::{Network, decode};
+use crate::model::{Network, StackNet, decode};
 use crate::run::{CONFIG_FILE, RunDir, RunState, build_net, grid_of};
+use crate::sample::Batch;
 use crate::shift_loss::{ShiftTargets, epishift_loss};
 use crate::shift_sample::ShiftBatch;
 use crate::tensors::{shift_input, stack_tensors, target_tensors};
@@ -220,11 +221,8 @@ impl Trainer {
     /// The loss of `batch` (scalar tensor with its graph).
     fn loss(&self, batch: &TrainBatch) -> Result<Tensor<1>> {
         Ok(match (&self.net, batch) {
-            (Network::Epi(net), TrainBatch::Stacks(b)) => {
-                let raw = net.forward(stack_tensors(b, &self.device));
-                let out = decode(raw, self.cfg.model, &StackInput::of(&self.cfg));
-                loss(&self.cfg, out, &target_tensors(b, &self.cfg, &self.device))
-            }
+            (Network::Epi(net), TrainBatch::Stacks(b)) => self.stacks_loss(net, b),
+            (Network::Cost(net), TrainBatch::Stacks(b)) => self.stacks_loss(net, b),
             (Network::Shift(net), TrainBatch::Shifts(b)) => {
                 let (class, reg) = net.forward(shift_input(b, &self.device));
                 let offsets = self.cfg.epishift.train_offsets();
@@ -233,6 +231,13 @@ impl Trainer {
             }
             _ => bail!("internal error: the batch does not fit the network"),
         })
+    }
+
+    /// The loss of a network on the four stacks.
+    fn stacks_loss(&self, net: &impl StackNet, b: &Batch) -> Tensor<1> {
+        let raw = net.forward(stack_tensors(b, &self.device));
+        let out = decode(raw, self.cfg.model, &StackInput::of(&self.cfg));
+        loss(&self.cfg, out, &target_tensors(b, &self.cfg, &self.device))
     }
 
     /// One Adam step on `batch`; returns its loss.
@@ -313,7 +318,7 @@ pub fn bench_steps(cfg: &TrainConfig, grid: usize, steps: usize) -> Result<(f64,
         })
     } else {
         let channels = StackInput::of(cfg).channels(grid);
-        TrainBatch::Stacks(crate::sample::Batch {
+        TrainBatch::Stacks(Batch {
             size: b,
             patch: p,
             stack_channels: channels,

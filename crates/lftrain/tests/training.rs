@@ -4,7 +4,7 @@
 
 use burn::prelude::*;
 use burn::tensor::TensorData;
-use lftrain::config::{EseOutside, ModelKind, NetConfig, NetInput, TrainConfig};
+use lftrain::config::{CostNetwork, EseOutside, ModelKind, NetConfig, NetInput, TrainConfig};
 use lftrain::loss::{TargetTensors, dpp_bin, loss};
 use lftrain::model::{EpiNet, turn_to_reference};
 use lftrain::stacks::{Direction, Region, extract};
@@ -117,7 +117,7 @@ fn tiny_net() -> NetConfig {
         stream_blocks: 1,
         head_width: 8,
         head_blocks: 1,
-        input: NetInput::Views,
+        ..NetConfig::default()
     }
 }
 
@@ -217,7 +217,7 @@ struct Overfit {
 
 /// Trains a tiny BASE on the whole of a tiny two-plane pair for 400 steps with `input`, and
 /// checks the run folder and that its checkpoint predicts in lfeval's format.
-fn overfit(input: NetInput) -> Overfit {
+fn overfit(input: NetInput, cost_network: CostNetwork) -> Overfit {
     use lftrain::train::train;
 
     let tmp = tempfile::tempdir().unwrap();
@@ -238,6 +238,8 @@ fn overfit(input: NetInput) -> Overfit {
             head_width: 16,
             head_blocks: 2,
             input,
+            cost_network,
+            ..NetConfig::default()
         },
         // Capacity, not the recipe: every pixel of the whole 24² scene trained at full rate
         // (validation scores all of it).
@@ -268,7 +270,7 @@ fn overfit(input: NetInput) -> Overfit {
         badpix: (badpix(&r[0]), badpix(last)),
     };
     eprintln!(
-        "overfit {input:?}: {:.1} s, loss {:.4} → {:.4}, MSE×100 {:.2} → {:.2}, BadPix(0.07) {:.1} → {:.1}",
+        "overfit {input:?} {cost_network:?}: {:.1} s, loss {:.4} → {:.4}, MSE×100 {:.2} → {:.2}, BadPix(0.07) {:.1} → {:.1}",
         t0.elapsed().as_secs_f64(),
         o.loss.0,
         o.loss.1,
@@ -299,7 +301,7 @@ fn overfit(input: NetInput) -> Overfit {
 
 #[test]
 fn tiny_model_overfits_tiny_dataset_then_predicts_for_lfeval() {
-    let o = overfit(NetInput::Views);
+    let o = overfit(NetInput::Views, CostNetwork::Streams);
     // Measured: loss ÷8, MSE×100 ÷17 (98.9 → 5.6), BadPix(0.07) 100 → 60 in ~14 s.
     assert!(o.loss.1 < o.loss.0 / 5.0, "loss {:?}", o.loss);
     assert!(o.mse.1 < o.mse.0 / 10.0, "MSE {:?}", o.mse);
@@ -308,11 +310,13 @@ fn tiny_model_overfits_tiny_dataset_then_predicts_for_lfeval() {
 
 #[test]
 fn a_cost_volume_model_learns_sub_hypothesis_disparities() {
-    let o = overfit(NetInput::Cost);
     // The hypotheses are 0.19 px apart: below 0.07 px at most pixels needs the soft argmin
     // to interpolate between them.
-    assert!(o.mse.1 < o.mse.0 / 10.0, "MSE {:?}", o.mse);
-    assert!(o.badpix.1 < 30.0, "BadPix {:?}", o.badpix);
+    for network in [CostNetwork::Streams, CostNetwork::PerHypothesis] {
+        let o = overfit(NetInput::Cost, network);
+        assert!(o.mse.1 < o.mse.0 / 10.0, "{network:?}: MSE {:?}", o.mse);
+        assert!(o.badpix.1 < 30.0, "{network:?}: BadPix {:?}", o.badpix);
+    }
 }
 
 #[test]
