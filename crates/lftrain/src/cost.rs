@@ -60,16 +60,17 @@ fn variance(stack: &[f32], n: usize, out: &mut [f32]) {
     }
 }
 
-/// Subtracts from every pixel the mean of its values over the planes of `volume`.
+/// Subtracts from every pixel the mean of its values over the planes of `volume`, plane by
+/// plane (contiguous reads; the loader runs this for every crop and direction).
 fn centre_per_pixel(volume: &mut [f32], plane: usize) {
     let k = (volume.len() / plane) as f32;
-    for i in 0..plane {
-        let mean = volume.iter().skip(i).step_by(plane).sum::<f32>() / k;
-        volume
-            .iter_mut()
-            .skip(i)
-            .step_by(plane)
-            .for_each(|v| *v -= mean);
+    let mut mean = vec![0.0f32; plane];
+    for slice in volume.chunks_exact(plane) {
+        mean.iter_mut().zip(slice).for_each(|(m, v)| *m += v);
+    }
+    mean.iter_mut().for_each(|m| *m /= k);
+    for slice in volume.chunks_exact_mut(plane) {
+        slice.iter_mut().zip(&mean).for_each(|(v, m)| *v -= m);
     }
 }
 
