@@ -17,22 +17,19 @@ const VARIANCE_FLOOR: f32 = 1e-5;
 /// Each plane is `ln(var + floor)` of the views' colours at that hypothesis (RGB variances
 /// summed), centred per pixel over the hypotheses: the logarithm makes a contrast change an
 /// offset, and the centring removes it, so the network sees where along the hypotheses the
-/// views agree, not how textured the pixel is in absolute terms. `photometric` is applied to
-/// the stack of each hypothesis before its variance, as it is to the views' stacks.
+/// views agree, not how textured the pixel is in absolute terms.
 pub fn cost_stack(
     lf: &LightField,
     dir: Direction,
     region: Region,
     shift: f32,
     hypotheses: &[f32],
-    photometric: impl Fn(&mut [f32]),
 ) -> Vec<f32> {
     let plane = region.width * region.height;
     let mut stack = vec![0.0; lf.n * 3 * plane];
     let mut out = vec![0.0; hypotheses.len() * plane];
     for (&h, slice) in hypotheses.iter().zip(out.chunks_exact_mut(plane)) {
         extract_into(lf, dir, region, shift + h, &mut stack);
-        photometric(&mut stack);
         variance(&stack, lf.n, slice);
         slice
             .iter_mut()
@@ -102,15 +99,17 @@ mod tests {
         };
         let dir = Direction::Diagonal45;
         let hyps = [-1.0, -0.5, 0.0, 0.5];
-        let base = cost_stack(&lf, dir, region, 0.5, &hyps, |_| ());
+        let base = cost_stack(&lf, dir, region, 0.5, &hyps);
         let moved: Vec<f32> = hyps.iter().map(|h| h + 0.5).collect();
-        assert_eq!(cost_stack(&lf, dir, region, 0.0, &moved, |_| ()), base);
+        assert_eq!(cost_stack(&lf, dir, region, 0.0, &moved), base);
         // Doubling the contrast about 0.5 quadruples every variance: after the logarithm
         // and the centring only the floor's share changes, which matters only where the
         // views agree to within the floor. The best hypothesis of every pixel stays.
-        let doubled = cost_stack(&lf, dir, region, 0.5, &hyps, |s| {
-            s.iter_mut().for_each(|x| *x = 0.5 + 2.0 * (*x - 0.5))
-        });
+        let mut contrast = lf.clone();
+        for view in contrast.views.iter_mut().flatten() {
+            view.iter_mut().for_each(|x| *x = 0.5 + 2.0 * (*x - 0.5));
+        }
+        let doubled = cost_stack(&contrast, dir, region, 0.5, &hyps);
         let plane = 16 * 16;
         let best = |c: &[f32], i: usize| {
             (0..hyps.len())
@@ -142,7 +141,7 @@ mod tests {
             height: 16,
         };
         for dir in Direction::ALL {
-            let cost = cost_stack(&lf, dir, region, 0.0, &hyps, |_| ());
+            let cost = cost_stack(&lf, dir, region, 0.0, &hyps);
             let plane = 16 * 16;
             for i in [0, 37, 255] {
                 let best = (0..hyps.len())
@@ -155,7 +154,7 @@ mod tests {
             }
             // At the true disparity the views agree to interpolation error only.
             let k = hyps.iter().position(|&h| h == d).unwrap();
-            let raw = cost_stack(&lf, dir, region, 0.0, &[d], |_| ());
+            let raw = cost_stack(&lf, dir, region, 0.0, &[d]);
             assert_eq!(raw.iter().copied().fold(0.0, f32::max), 0.0);
             let _ = k;
         }

@@ -40,23 +40,11 @@ impl StackInput {
         }
     }
 
-    /// The input planes of stack `dir` over `region` of `lf` EPI-shifted by `shift`, with
-    /// `photometric` applied to the views' colours.
-    pub fn planes(
-        &self,
-        lf: &LightField,
-        dir: Direction,
-        region: Region,
-        shift: f32,
-        photometric: impl Fn(&mut [f32]),
-    ) -> Vec<f32> {
+    /// The input planes of stack `dir` over `region` of `lf` EPI-shifted by `shift`.
+    pub fn planes(&self, lf: &LightField, dir: Direction, region: Region, shift: f32) -> Vec<f32> {
         match self {
-            StackInput::Views => {
-                let mut s = extract(lf, dir, region, shift);
-                photometric(&mut s);
-                s
-            }
-            StackInput::Cost(h) => cost_stack(lf, dir, region, shift, h, photometric),
+            StackInput::Views => extract(lf, dir, region, shift),
+            StackInput::Cost(h) => cost_stack(lf, dir, region, shift, h),
         }
     }
 }

@@ -17,6 +17,21 @@ use lftrain::train::{TrainArgs, bench_loader, bench_steps, train};
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
+/// mimalloc's `mi_option_purge_delay`: its index in mimalloc v3's `mi_option_e`, the library
+/// libmimalloc-sys 0.1.49 builds but does not name (the test below checks the index by the
+/// option's documented default).
+const MI_OPTION_PURGE_DELAY: libmimalloc_sys::mi_option_t = 15;
+
+/// Even mimalloc hands freed pages back to the kernel a second after they empty, and a step
+/// takes longer than that: each step's large tensors then fault in as freshly zeroed huge
+/// pages again, 16 % of a `cpu_cost.toml` step in the kernel's `clear_page` (perf). Never
+/// purging keeps them; the process holds its peak working set, which it reaches every step
+/// anyway. Set before the first large allocation.
+fn keep_freed_pages() {
+    // SAFETY: sets a plain integer option; mimalloc reads it on its next purge decision.
+    unsafe { libmimalloc_sys::mi_option_set(MI_OPTION_PURGE_DELAY, -1) }
+}
+
 #[derive(Parser)]
 #[command(
     version,
@@ -129,6 +144,7 @@ struct TrainCmd {
 }
 
 fn main() -> ExitCode {
+    keep_freed_pages();
     let cli = Cli::parse();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
@@ -252,4 +268,21 @@ fn parse_range(s: &str) -> std::result::Result<[f32; 2], String> {
         return Err(bad());
     }
     Ok(r)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The index names the purge delay: its default in mimalloc v3's `options.c` (1 000 ms)
+    /// unless the environment overrides it, and what `keep_freed_pages` sets.
+    #[test]
+    fn the_purge_delay_option_is_the_one_set() {
+        let get = || unsafe { libmimalloc_sys::mi_option_get(MI_OPTION_PURGE_DELAY) };
+        if std::env::var_os("MIMALLOC_PURGE_DELAY").is_none() {
+            assert_eq!(get(), 1000);
+        }
+        keep_freed_pages();
+        assert_eq!(get(), -1);
+    }
 }

@@ -60,7 +60,7 @@ fn run_once(
 ) -> Vec<Vec<f32>> {
     let region = Region::whole(lf);
     let shape = [1, input.channels(lf.n), lf.height, lf.width];
-    let planes = |dir| input.planes(lf, dir, region, shift, |_| ());
+    let planes = |dir| input.planes(lf, dir, region, shift);
     let stacks = Direction::ALL.map(|dir| tensor4(planes(dir), shape, device));
     let out = values(decode(net.forward(stacks), model, input));
     out.chunks_exact(lf.width * lf.height)

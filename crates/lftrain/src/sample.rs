@@ -101,7 +101,7 @@ pub fn make_sample(
     let (x0, y0) = (draw.origin.0 as isize, draw.origin.1 as isize);
     let (m, k) = (margin as isize, draw.scale.max(1));
     let side = patch + 2 * margin;
-    let lf = (scene.lf)
+    let mut lf = (scene.lf)
         .crop((x0 - m * k as isize, y0 - m * k as isize), (side, side), k)
         .rotate(draw.turns);
     let region = Region {
@@ -121,8 +121,13 @@ pub fn make_sample(
         1,
     );
     let pivot = draw.photometric.pivot(&centre);
-    let photometric = |s: &mut [f32]| draw.photometric.apply(s, patch * patch, pivot);
-    let stacks = Direction::ALL.map(|dir| input.planes(&lf, dir, region, draw.shift, photometric));
+    // Once on the crop's views (RGB interleaved: one pixel per "view" of `apply`), not on
+    // every stack: the draw is affine per pixel and commutes with the stacks' bilinear
+    // resampling, and a cost volume resamples each view once per hypothesis.
+    for view in lf.views.iter_mut().flatten() {
+        draw.photometric.apply(view, 1, pivot);
+    }
+    let stacks = Direction::ALL.map(|dir| input.planes(&lf, dir, region, draw.shift));
     let (disparity, mut eta) = target_planes(&scene.targets, (x0, y0), patch, draw);
     let region = loss_region(scene, (x0, y0), patch, draw, border);
     for slot in eta.chunks_exact_mut(patch * patch) {
