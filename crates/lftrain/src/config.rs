@@ -938,6 +938,26 @@ mod tests {
         assert!(err.contains("net.input"), "{err}");
     }
 
+    /// ESE's cost recipe is the cost recipe with ESE's own keys only: the EPI-shift
+    /// augmentation its passes need, `log b` kept high outside the interval, passes over
+    /// each scene's range.
+    #[test]
+    fn the_ese_cost_recipe_differs_from_the_cost_recipe_in_ese_keys_only() {
+        let read = |text| -> TrainConfig { toml::from_str(text).unwrap() };
+        let cost = read(include_str!("../configs/cpu_cost.toml"));
+        let ese = read(include_str!("../configs/cpu_cost_ese.toml"));
+        ese.validate().unwrap();
+        assert_eq!(ese.model, ModelKind::Ese);
+        assert_eq!(ese.augment.max_shift, 3.0);
+        assert_eq!(ese.ese.outside, EseOutside::Uncertain);
+        assert!(ese.ese.scene_range);
+        let mut back = ese.clone();
+        back.model = cost.model;
+        back.augment.max_shift = cost.augment.max_shift;
+        back.ese = cost.ese.clone();
+        assert_eq!(back, cost);
+    }
+
     /// The GPU check's config is the thesis' recipe (the defaults) at batch 64 for 200 steps:
     /// only the batch and the run's bookkeeping differ, so its timings are the thesis net's.
     #[test]
