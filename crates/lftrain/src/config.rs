@@ -904,7 +904,7 @@ mod tests {
 
     /// The cost recipe: the per-hypothesis net on 60 hypotheses over ±4.5 px, radius 4 px
     /// (the baseline's 9×9 window), no EPI shift (the targets must stay inside the
-    /// hypotheses), the field recipe's schedule scaled to 2 000 steps.
+    /// hypotheses), the field recipe's schedule scaled to 1 000 steps.
     #[test]
     fn the_cost_recipe_reads_cost_volumes_and_refuses_epishift() {
         let cost: TrainConfig = toml::from_str(include_str!("../configs/cpu_cost.toml")).unwrap();
@@ -920,7 +920,7 @@ mod tests {
                 cost.warmup_steps,
                 cost.lr_decay_steps.as_slice()
             ),
-            (2000, 500, &[1500][..])
+            (1000, 250, &[750][..])
         );
         assert_eq!(TrainConfig::default().net.input, NetInput::Views);
         // One logit per hypothesis, and log b for UPR and ESE.

@@ -102,6 +102,11 @@ pub fn extract_into(lf: &LightField, dir: Direction, region: Region, shift: f32,
 
 /// Bilinear samples of the RGB image `rgb` at `(x + ox, y + oy)` for every pixel of `region`
 /// into three planes of `out`; coordinates are clamped to the image.
+///
+/// The loader's hottest loop (a cost volume resamples each view once per hypothesis), so the
+/// columns whose two source pixels lie inside the image run without clamping or per-pixel
+/// index arithmetic; both paths evaluate the same expression in the same order, so the
+/// result does not depend on which one a pixel takes.
 fn sample_shifted(
     rgb: &[f32],
     w: usize,
@@ -113,18 +118,49 @@ fn sample_shifted(
     let plane = region.width * region.height;
     let (fx, fy) = (ox.floor(), oy.floor());
     let (ax, ay) = (ox - fx, oy - fy);
+    let lerp = |a: f32, b: f32, c: f32, d: f32| {
+        let top = a * (1.0 - ax) + b * ax;
+        let bottom = c * (1.0 - ax) + d * ax;
+        top * (1.0 - ay) + bottom * ay
+    };
     let clamp = |v: isize, max: usize| v.clamp(0, max as isize - 1) as usize;
+    let (red, rest) = out[..3 * plane].split_at_mut(plane);
+    let (green, blue) = rest.split_at_mut(plane);
+    // Source column of output column 0; columns lo..hi read sx and sx + 1 unclamped.
+    let base = region.x0 as isize + fx as isize;
+    let lo = (-base).clamp(0, region.width as isize) as usize;
+    let hi = (w as isize - 1 - base).clamp(lo as isize, region.width as isize) as usize;
     for y in 0..region.height {
         let sy = (region.y0 + y) as isize + fy as isize;
-        let (y0, y1) = (clamp(sy, h), clamp(sy + 1, h));
-        for x in 0..region.width {
-            let sx = (region.x0 + x) as isize + fx as isize;
-            let (x0, x1) = (clamp(sx, w), clamp(sx + 1, w));
-            for ch in 0..3 {
-                let at = |xx: usize, yy: usize| rgb[(yy * w + xx) * 3 + ch];
-                let top = at(x0, y0) * (1.0 - ax) + at(x1, y0) * ax;
-                let bottom = at(x0, y1) * (1.0 - ax) + at(x1, y1) * ax;
-                out[ch * plane + y * region.width + x] = top * (1.0 - ay) + bottom * ay;
+        let row = |r: usize| &rgb[r * w * 3..(r + 1) * w * 3];
+        let (r0, r1) = (row(clamp(sy, h)), row(clamp(sy + 1, h)));
+        let at = y * region.width;
+        let mut planes = [
+            &mut red[at..at + region.width],
+            &mut green[at..at + region.width],
+            &mut blue[at..at + region.width],
+        ];
+        for x in (0..lo).chain(hi..region.width) {
+            let sx = base + x as isize;
+            let (x0, x1) = (clamp(sx, w) * 3, clamp(sx + 1, w) * 3);
+            for (ch, p) in planes.iter_mut().enumerate() {
+                p[x] = lerp(r0[x0 + ch], r0[x1 + ch], r1[x0 + ch], r1[x1 + ch]);
+            }
+        }
+        if lo < hi {
+            let s0 = (base + lo as isize) as usize * 3;
+            let span = 3 * (hi - lo);
+            let (t0, t1) = (&r0[s0..s0 + span + 3], &r1[s0..s0 + span + 3]);
+            let [pr, pg, pb] = planes;
+            let pixels = (pr[lo..hi].iter_mut())
+                .zip(pg[lo..hi].iter_mut())
+                .zip(pb[lo..hi].iter_mut())
+                .zip(t0.chunks_exact(3).zip(t0[3..].chunks_exact(3)))
+                .zip(t1.chunks_exact(3).zip(t1[3..].chunks_exact(3)));
+            for ((((r, g), b), (a0, b0)), (a1, b1)) in pixels {
+                *r = lerp(a0[0], b0[0], a1[0], b1[0]);
+                *g = lerp(a0[1], b0[1], a1[1], b1[1]);
+                *b = lerp(a0[2], b0[2], a1[2], b1[2]);
             }
         }
     }
@@ -193,6 +229,55 @@ mod tests {
                 .map(|(a, b)| (a - b).abs())
                 .fold(0.0, f32::max);
             assert!(worst < 1e-5, "{dir:?}: {worst}");
+        }
+    }
+
+    /// The interior fast path of `sample_shifted` gives bit for bit what clamping every
+    /// pixel gives, for shifts that leave the image on either side and regions at its edges.
+    #[test]
+    fn the_unclamped_interior_is_bit_identical_to_clamping_everywhere() {
+        let (w, h) = (23, 17);
+        let rgb: Vec<f32> = (0..w * h * 3)
+            .map(|i| ((i * 37) % 101) as f32 / 101.0)
+            .collect();
+        let reference = |region: Region, (ox, oy): (f32, f32)| {
+            let clamp = |v: f32, max: usize| (v.max(0.0) as usize).min(max - 1);
+            let mut out = vec![0.0; 3 * region.width * region.height];
+            let (fx, fy) = (ox.floor(), oy.floor());
+            let (ax, ay) = (ox - fx, oy - fy);
+            for y in 0..region.height {
+                for x in 0..region.width {
+                    let sx = (region.x0 + x) as f32 + fx;
+                    let sy = (region.y0 + y) as f32 + fy;
+                    let (x0, x1) = (clamp(sx, w), clamp(sx + 1.0, w));
+                    let (y0, y1) = (clamp(sy, h), clamp(sy + 1.0, h));
+                    for ch in 0..3 {
+                        let at = |xx: usize, yy: usize| rgb[(yy * w + xx) * 3 + ch];
+                        let top = at(x0, y0) * (1.0 - ax) + at(x1, y0) * ax;
+                        let bottom = at(x0, y1) * (1.0 - ax) + at(x1, y1) * ax;
+                        out[(ch * region.height + y) * region.width + x] =
+                            top * (1.0 - ay) + bottom * ay;
+                    }
+                }
+            }
+            out
+        };
+        let regions = [(0, 0, 23, 17), (3, 2, 12, 9), (15, 10, 8, 7), (0, 5, 5, 5)];
+        let shifts = [0.0, 0.37, -2.6, 7.9, -30.2, 25.5];
+        for (x0, y0, width, height) in regions {
+            let region = Region {
+                x0,
+                y0,
+                width,
+                height,
+            };
+            for &sx in &shifts {
+                for &sy in &[0.0, -1.25, 3.5] {
+                    let mut out = vec![0.0; 3 * width * height];
+                    sample_shifted(&rgb, w, h, region, (sx, sy), &mut out);
+                    assert_eq!(out, reference(region, (sx, sy)), "{region:?} {sx} {sy}");
+                }
+            }
         }
     }
 }
