@@ -10,7 +10,7 @@ use lfeval::prediction::ScenePrediction;
 use lfeval::{Bins, laplace};
 use lfformat::pfm::FloatImage;
 
-use crate::config::{EsePoint, ModelKind, TrainConfig};
+use crate::config::{EsePoint, ModelKind, NetInput, TrainConfig};
 use crate::epishift::EpiShiftNet;
 use crate::input::StackInput;
 use crate::lightfield::{LightField, rotate_plane};
@@ -355,6 +355,45 @@ impl Overrides {
     }
 }
 
+/// The disparities a model can output without EPI shifts: a DPP's bins, and the hypotheses
+/// of a cost-volume input (its soft argmin stays between them). `None` where nothing bounds
+/// it: a regression on the views, and ESE and EPI-Shift, which shift to the scene's range.
+pub fn output_range(cfg: &TrainConfig) -> Option<[f32; 2]> {
+    match (cfg.model, cfg.net.input) {
+        (ModelKind::Ese | ModelKind::EpiShift, _) => None,
+        (ModelKind::Dpp, _) | (_, NetInput::Cost) => Some([cfg.dpp.min, cfg.dpp.max]),
+        _ => None,
+    }
+}
+
+/// The warning for the scenes (name, `parameters.cfg` range) whose range leaves `reach`, or
+/// `None` when all fit: a researcher running a narrow model on wide scenes must not take the
+/// clamped disparities for its answer.
+fn reach_warning(
+    model: ModelKind,
+    reach: [f32; 2],
+    scenes: &[(String, [f32; 2])],
+) -> Option<String> {
+    let beyond: Vec<&str> = scenes
+        .iter()
+        .filter(|(_, [lo, hi])| *lo < reach[0] || *hi > reach[1])
+        .map(|(name, _)| name.as_str())
+        .collect();
+    (!beyond.is_empty()).then(|| {
+        format!(
+            "warning: {} of {} scenes ({}) have a parameters.cfg disparity range beyond \
+             [{}, {}] px, all this {} model can output; their farther pixels are clamped \
+             (EPI-Shift, or ESE over the scene's range, reaches them)",
+            beyond.len(),
+            scenes.len(),
+            beyond.join(", "),
+            reach[0],
+            reach[1],
+            model.name()
+        )
+    })
+}
+
 /// [`predict_dataset`] with the run's config changed by `overrides`.
 pub fn predict_dataset_over(
     run: &std::path::Path,
@@ -370,8 +409,10 @@ pub fn predict_dataset_over(
     let net = run.load_net(&cfg, state.grid, &device)?.valid();
     let scenes = lfformat::dataset::discover(dataset, &[])?;
     let bar = lfeval::pipeline::progress(scenes.len(), "predicting", quiet);
+    let mut ranges = Vec::new();
     for s in &scenes {
         let lf = LightField::load(&s.path)?;
+        ranges.extend(lf.disparity_range.map(|r| (s.name.clone(), r)));
         if lf.n != state.grid {
             anyhow::bail!(
                 "{}: {}x{} views, the network was trained on {}x{}",
@@ -387,12 +428,51 @@ pub fn predict_dataset_over(
         bar.inc(1);
     }
     bar.finish_and_clear();
+    let warning = output_range(&cfg).and_then(|reach| reach_warning(cfg.model, reach, &ranges));
+    if let Some(w) = warning {
+        eprintln!("lftrain predict: {w}");
+    }
     Ok(scenes.len())
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// DPP and cost-volume models are bounded by the `[dpp]` range; views regressions, ESE
+    /// and EPI-Shift are not. Only scenes reaching past it are named.
+    #[test]
+    fn narrow_models_warn_about_scenes_beyond_their_range() {
+        let cfg = |model, input| {
+            let mut c = TrainConfig {
+                model,
+                ..TrainConfig::default()
+            };
+            c.net.input = input;
+            (c.dpp.min, c.dpp.max) = (-4.5, 4.5);
+            output_range(&c)
+        };
+        assert_eq!(cfg(ModelKind::Dpp, NetInput::Views), Some([-4.5, 4.5]));
+        assert_eq!(cfg(ModelKind::Base, NetInput::Cost), Some([-4.5, 4.5]));
+        assert_eq!(cfg(ModelKind::Upr, NetInput::Cost), Some([-4.5, 4.5]));
+        assert_eq!(cfg(ModelKind::Base, NetInput::Views), None);
+        assert_eq!(cfg(ModelKind::Ese, NetInput::Cost), None);
+        let scenes = [
+            ("narrow".to_string(), [-3.5, 3.5]),
+            ("wide".to_string(), [-40.0, 40.0]),
+            ("far".to_string(), [-5.0, 1.0]),
+        ];
+        let w = reach_warning(ModelKind::Dpp, [-4.5, 4.5], &scenes).unwrap();
+        assert!(w.contains("2 of 3 scenes (wide, far)"), "{w}");
+        assert!(
+            w.contains("[-4.5, 4.5] px") && w.contains("dpp model"),
+            "{w}"
+        );
+        assert_eq!(
+            reach_warning(ModelKind::Dpp, [-4.5, 4.5], &scenes[..1]),
+            None
+        );
+    }
 
     /// Bins of width 1 over [0, n): bin `k`'s centre is `k + 0.5`.
     fn unit_bins(n: usize) -> Bins {
