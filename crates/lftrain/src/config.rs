@@ -39,11 +39,15 @@ impl ModelKind {
     /// Channels of the network's last layer for `input`: the output channels on views; on a
     /// cost volume one logit per bin, plus `log b` for UPR and ESE (see [`NetInput::Cost`]).
     pub fn net_channels(self, input: NetInput, dpp_bins: usize) -> usize {
-        match (input, self) {
-            (NetInput::Views, _) => self.out_channels(dpp_bins),
-            (NetInput::Cost, ModelKind::Base | ModelKind::Dpp) => dpp_bins,
-            (NetInput::Cost, _) => dpp_bins + 1,
+        match input {
+            NetInput::Views => self.out_channels(dpp_bins),
+            NetInput::Cost => dpp_bins + usize::from(self.has_spread()),
         }
+    }
+
+    /// Whether the model predicts a Laplacian's `log b` beside its disparity (UPR, ESE).
+    pub fn has_spread(self) -> bool {
+        matches!(self, ModelKind::Upr | ModelKind::Ese)
     }
 
     /// Lower-case name (file and log names).

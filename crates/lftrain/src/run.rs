@@ -125,7 +125,7 @@ pub fn build_net(cfg: &TrainConfig, grid: usize, device: &Device) -> Network {
         _ if cfg.net.input == NetInput::Cost
             && cfg.net.cost_network == CostNetwork::PerHypothesis =>
         {
-            let spread = matches!(cfg.model, ModelKind::Upr | ModelKind::Ese);
+            let spread = cfg.model.has_spread();
             Network::Cost(CostNet::new(&cfg.net, cfg.dpp.bins, spread, device))
         }
         _ => Network::Epi(EpiNet::new(

@@ -123,6 +123,7 @@ pub fn train(mut cfg: TrainConfig, args: &TrainArgs) -> Result<TrainSummary> {
     let loader = Loader::start(train_scenes, cfg.clone(), args.pool, state.step as u64)?;
     let mut log = TrainLog::open(&args.out, args.resume, state.step)?;
     let mut trainer = Trainer {
+        input: StackInput::of(&cfg),
         cfg,
         net,
         optim,
@@ -137,6 +138,8 @@ pub fn train(mut cfg: TrainConfig, args: &TrainArgs) -> Result<TrainSummary> {
 /// The mutable state of a training run.
 struct Trainer {
     cfg: TrainConfig,
+    /// `cfg`'s input, resolved once (its hypotheses) instead of every step.
+    input: StackInput,
     net: Network,
     optim: ModuleOptimizer,
     device: Device,
@@ -236,7 +239,7 @@ impl Trainer {
     /// The loss of a network on the four stacks.
     fn stacks_loss(&self, net: &impl StackNet, b: &Batch) -> Tensor<1> {
         let raw = net.forward(stack_tensors(b, &self.device));
-        let out = decode(raw, self.cfg.model, &StackInput::of(&self.cfg));
+        let out = decode(raw, self.cfg.model, &self.input);
         loss(&self.cfg, out, &target_tensors(b, &self.cfg, &self.device))
     }
 
@@ -331,6 +334,7 @@ pub fn bench_steps(cfg: &TrainConfig, grid: usize, steps: usize) -> Result<(f64,
     };
     let mut trainer = Trainer {
         cfg: cfg.clone(),
+        input: StackInput::of(cfg),
         net: build_net(cfg, grid, &device),
         optim: adam(cfg),
         device,
