@@ -11,10 +11,11 @@
 //! Layout: the data pipeline is [`lightfield`] (views, crop, rotation), [`stacks`] (the four
 //! stacks and the EPI shift), [`cost`] and [`input`] (a stack's cost volume, the alternative
 //! network input, which [`costnet`] can aggregate), [`augment`] (colours), [`scene`]
-//! (targets), [`sample`] (one augmented crop, batches) and [`loader`] (background prefetch); the learning side is [`model`], [`loss`] and
-//! [`tensors`]; EPI-Shift's own parts are [`shift_sample`], [`unet`], [`epishift`],
-//! [`shift_loss`] and [`shift_predict`]; [`train`], [`validate`], [`predict`], [`run`] (the
-//! run folder) and [`log`] are the commands' machinery; [`config`] holds every setting.
+//! (targets), [`sample`] (one augmented crop, batches) and [`loader`] (background prefetch);
+//! the learning side is [`model`], [`loss`] and [`tensors`]; EPI-Shift's own parts are
+//! [`shift_sample`], [`unet`], [`epishift`], [`shift_loss`] and [`shift_predict`]; [`train`],
+//! [`validate`], [`predict`], [`run`] (the run folder) and [`log`] are the commands'
+//! machinery; [`config`] holds every setting.
 
 pub mod augment;
 pub mod config;

@@ -23,7 +23,7 @@ fn scene_range(cfg: &EpiShiftConfig, lf: &LightField) -> [f32; 2] {
     cfg.range.or(lf.disparity_range).unwrap_or(FALLBACK_RANGE)
 }
 
-/// The inference shifts for `lf`: every integer shift of its [`scene_range`].
+/// The inference shifts for `lf`: every integer shift of its range (`scene_range`).
 pub fn scene_shifts(cfg: &EpiShiftConfig, lf: &LightField) -> Vec<i32> {
     let [lo, hi] = scene_range(cfg, lf);
     let mut shifts = EpiShiftConfig::shifts_for(lo, hi);

@@ -268,11 +268,11 @@ fn overfit(input: NetInput, cost_network: CostNetwork) -> Overfit {
     // overfit passed alone and failed once in a full `.ci/run`, 34.3 against 30).
     let tail = &r[r.len() - 20..];
     let best =
-        |f: &dyn Fn(&lftrain::log::Record) -> f64| tail.iter().map(f).fold(f64::INFINITY, f64::min);
+        |f: fn(&lftrain::log::Record) -> f64| tail.iter().map(f).fold(f64::INFINITY, f64::min);
     let o = Overfit {
         loss: (mean_loss(&r[..5]), mean_loss(&r[r.len() - 5..])),
-        mse: (mse(&r[0]), best(&mse)),
-        badpix: (badpix(&r[0]), best(&badpix)),
+        mse: (mse(&r[0]), best(mse)),
+        badpix: (badpix(&r[0]), best(badpix)),
     };
     eprintln!(
         "overfit {input:?} {cost_network:?}: {:.1} s, loss {:.4} → {:.4}, MSE×100 {:.2} → {:.2}, BadPix(0.07) {:.1} → {:.1}",
