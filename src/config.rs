@@ -208,6 +208,9 @@ pub struct RenderConfig {
     /// Shared shading: glossy lobes at least this many times as wide as the camera grid's
     /// angle at a point are shared by all views (see `render::cache`).
     pub glossy_share: f64,
+    /// Shared shading: glossy lobes narrower than this (`2α`, radians) stay per view whatever
+    /// the grid spans (see `render::cache`).
+    pub glossy_min_width: f64,
     /// Shared shading: vertices of each fill path whose coupled-irradiance estimates the cache
     /// keeps (1: the first alone; see `render::cache::CacheSums::add_later`). Only the path's
     /// own vertices, below `max_depth`, take part: larger values act as `max_depth`.
@@ -248,6 +251,7 @@ impl Default for RenderConfig {
             cache_spp: 1,
             cache_cell: 1.0,
             glossy_share: 4.0,
+            glossy_min_width: 0.15,
             fill_vertices: 5,
             fill_light_samples: 4,
             texture_filter: true,
@@ -426,6 +430,12 @@ impl Config {
             bail!(
                 "render.glossy_share must be a number ≥ 0, got {}",
                 r.glossy_share
+            );
+        }
+        if !(r.glossy_min_width.is_finite() && r.glossy_min_width >= 0.0) {
+            bail!(
+                "render.glossy_min_width must be a number ≥ 0 (radians), got {}",
+                r.glossy_min_width
             );
         }
         if r.spp > MAX_SPP || r.slices > MAX_SLICES || r.max_depth > MAX_DEPTH {

@@ -86,6 +86,7 @@ impl RenderJob {
             cache: CacheParams {
                 cell_px: r.cache_cell as f32,
                 glossy_share: r.glossy_share as f32,
+                glossy_min_width: r.glossy_min_width as f32,
                 fill_vertices: r.fill_vertices,
                 fill_light_samples: r.fill_light_samples,
             },

@@ -182,6 +182,8 @@ fn hostile_config_values_are_refused_with_the_key_named() {
         "render.max_depth=100000",
         "render.glossy_share=-1",
         "render.glossy_share=nan",
+        "render.glossy_min_width=-0.1",
+        "render.glossy_min_width=inf",
         "camera.grid=[0,0]",
         "camera.grid=[35,35]",
         "camera.resolution=[4294967295,1]",

@@ -33,7 +33,10 @@
 //! view's position in the grid, `G(u, v) = G₀ + u·∂G/∂u + v·∂G/∂v` (least squares over its
 //! samples), and a view reads the fit at its own `(u, v)`: what is left is the curvature of
 //! the lobe's light over the grid, second order in `span / width`. Lobes narrower than
-//! `glossy_share` times the grid's angle (mirrors, polished surfaces) stay per view.
+//! `glossy_share` times the grid's angle (mirrors, polished surfaces) stay per view, and so do
+//! lobes narrower than `glossy_min_width` whatever the grid spans: such a lobe reflects detail
+//! that changes within a cell, which the cell's one value blurs (a grid spanning almost no
+//! angle, far surfaces at 512², or a single view, would otherwise share mirrors).
 
 use crate::camera::LightFieldCamera;
 use crate::util::hash::mix64;
@@ -51,6 +54,8 @@ pub struct CacheParams {
     /// grid spans at a point is shared; narrower ones are traced per view. 0 shares every
     /// glossy lobe, mirrors included.
     pub glossy_share: f32,
+    /// Lobes narrower than this (`2α`, radians) are never shared, whatever the grid spans.
+    pub glossy_min_width: f32,
     /// Vertices of a fill path whose coupled-irradiance estimates the cells keep: 1 is the
     /// first (the camera's) alone; more adds those of its later surface vertices, up to
     /// [`MAX_FILL_VERTICES`] (see [`CacheSums::add_later`]).
@@ -72,6 +77,8 @@ pub struct CacheGrid {
     cell_per_depth: f64,
     /// `glossy_share` times the distance between the grid's outermost cameras (metres).
     shared_lobe_span: f64,
+    /// [`CacheParams::glossy_min_width`].
+    min_shared_width: f32,
     /// [`CacheParams::fill_vertices`].
     pub fill_vertices: u32,
     /// Light samples at a fill path's first vertex, averaged. The cell's estimate there is
@@ -90,16 +97,18 @@ impl CacheGrid {
             forward: cam.forward,
             cell_per_depth: params.cell_px as f64 / cam.f_px(),
             shared_lobe_span: params.glossy_share as f64 * gx.hypot(gy) * cam.baseline_m,
+            min_shared_width: params.glossy_min_width,
             fill_vertices: params.fill_vertices.clamp(1, MAX_FILL_VERTICES),
             fill_light_samples: params.fill_light_samples.max(1),
         }
     }
 
     /// Whether a glossy lobe `width` radians wide (`2α`) at `p` is shared by all views: it is
-    /// at least `glossy_share` times the angle the camera grid spans seen from `p`.
+    /// at least `glossy_share` times the angle the camera grid spans seen from `p`, and at
+    /// least `glossy_min_width`.
     pub fn shares_glossy(&self, p: Vec3, width: f32) -> bool {
         let dist = (p.as_dvec3() - self.origin).length();
-        width as f64 * dist >= self.shared_lobe_span
+        width >= self.min_shared_width && width as f64 * dist >= self.shared_lobe_span
     }
 
     /// The cells of point `p` with shading normal `n` on material `material`: at the level
@@ -524,6 +533,7 @@ mod tests {
     const PARAMS: CacheParams = CacheParams {
         cell_px: 1.0,
         glossy_share: 4.0,
+        glossy_min_width: 0.0,
         fill_vertices: 1,
         fill_light_samples: 1,
     };
@@ -662,5 +672,46 @@ mod tests {
             },
         );
         assert!(all.shares_glossy(p, 0.0));
+    }
+
+    #[test]
+    fn a_lobe_narrower_than_the_floor_stays_per_view_whatever_the_grid() {
+        // A single view spans no angle: without the floor every lobe, mirrors too, is shared.
+        let grid = |glossy_min_width| {
+            let params = CacheParams {
+                glossy_min_width,
+                ..PARAMS
+            };
+            CacheGrid::new(&camera(), params)
+        };
+        let p = Vec3::new(0.0, 0.0, -3.0);
+        assert!(grid(0.0).shares_glossy(p, 0.08));
+        assert!(
+            !grid(0.15).shares_glossy(p, 0.08),
+            "roughness 0.2: 2α = 0.08 rad"
+        );
+        assert!(!grid(0.15).shares_glossy(p, 0.1499));
+        assert!(grid(0.15).shares_glossy(p, 0.15));
+        // Beside a grid's own rule: the floor only removes lobes from the shared set.
+        let cam = LightFieldCamera {
+            grid: [9, 9],
+            baseline_m: 0.01,
+            ..camera()
+        };
+        let nine = CacheGrid::new(
+            &cam,
+            CacheParams {
+                glossy_min_width: 0.15,
+                ..PARAMS
+            },
+        );
+        // At 2 m the grid's rule asks for 4 × 8√2 cm / 2 m = 0.226 rad, above the floor.
+        let near = Vec3::new(0.0, 0.0, -2.0);
+        let rule = 4.0 * 0.08 * std::f32::consts::SQRT_2 / 2.0;
+        assert!(!nine.shares_glossy(near, rule * 0.999));
+        assert!(nine.shares_glossy(near, rule * 1.001));
+        // At 8 m it asks for 0.057 rad: the floor decides.
+        assert!(!nine.shares_glossy(4.0 * near, 0.1));
+        assert!(nine.shares_glossy(4.0 * near, 0.15));
     }
 }
