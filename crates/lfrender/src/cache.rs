@@ -52,7 +52,7 @@ pub struct CacheParams {
     pub cell_px: f32,
     /// A glossy lobe at least this many times as wide (`2α`, radians) as the angle the camera
     /// grid spans at a point is shared; narrower ones are traced per view. 0 shares every
-    /// glossy lobe, mirrors included.
+    /// glossy lobe at least `glossy_min_width` wide (with that 0 too, mirrors included).
     pub glossy_share: f32,
     /// Lobes narrower than this (`2α`, radians) are never shared, whatever the grid spans.
     pub glossy_min_width: f32,
