@@ -251,7 +251,7 @@ impl Default for RenderConfig {
             cache_spp: 1,
             cache_cell: 1.0,
             glossy_share: 4.0,
-            glossy_min_width: 0.15,
+            glossy_min_width: 0.1,
             fill_vertices: 5,
             fill_light_samples: 4,
             texture_filter: true,

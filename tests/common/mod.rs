@@ -45,7 +45,7 @@ pub fn camera(
 pub const CACHE: CacheParams = CacheParams {
     cell_px: 1.0,
     glossy_share: 4.0,
-    glossy_min_width: 0.15,
+    glossy_min_width: 0.1,
     fill_vertices: 5,
     fill_light_samples: 1,
 };

@@ -687,11 +687,11 @@ mod tests {
         let p = Vec3::new(0.0, 0.0, -3.0);
         assert!(grid(0.0).shares_glossy(p, 0.08));
         assert!(
-            !grid(0.15).shares_glossy(p, 0.08),
+            !grid(0.1).shares_glossy(p, 0.08),
             "roughness 0.2: 2α = 0.08 rad"
         );
-        assert!(!grid(0.15).shares_glossy(p, 0.1499));
-        assert!(grid(0.15).shares_glossy(p, 0.15));
+        assert!(!grid(0.1).shares_glossy(p, 0.0999));
+        assert!(grid(0.1).shares_glossy(p, 0.1));
         // Beside a grid's own rule: the floor only removes lobes from the shared set.
         let cam = LightFieldCamera {
             grid: [9, 9],
@@ -701,7 +701,7 @@ mod tests {
         let nine = CacheGrid::new(
             &cam,
             CacheParams {
-                glossy_min_width: 0.15,
+                glossy_min_width: 0.1,
                 ..PARAMS
             },
         );
@@ -711,7 +711,7 @@ mod tests {
         assert!(!nine.shares_glossy(near, rule * 0.999));
         assert!(nine.shares_glossy(near, rule * 1.001));
         // At 8 m it asks for 0.057 rad: the floor decides.
-        assert!(!nine.shares_glossy(4.0 * near, 0.1));
-        assert!(nine.shares_glossy(4.0 * near, 0.15));
+        assert!(!nine.shares_glossy(4.0 * near, 0.08));
+        assert!(nine.shares_glossy(4.0 * near, 0.1));
     }
 }
