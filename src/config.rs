@@ -426,17 +426,13 @@ impl Config {
                 r.fill_light_samples
             );
         }
-        if !(r.glossy_share.is_finite() && r.glossy_share >= 0.0) {
-            bail!(
-                "render.glossy_share must be a number ≥ 0, got {}",
-                r.glossy_share
-            );
-        }
-        if !(r.glossy_min_width.is_finite() && r.glossy_min_width >= 0.0) {
-            bail!(
-                "render.glossy_min_width must be a number ≥ 0 (radians), got {}",
-                r.glossy_min_width
-            );
+        for (key, value) in [
+            ("glossy_share", r.glossy_share),
+            ("glossy_min_width", r.glossy_min_width),
+        ] {
+            if !(value.is_finite() && value >= 0.0) {
+                bail!("render.{key} must be a number ≥ 0, got {value}");
+            }
         }
         if r.spp > MAX_SPP || r.slices > MAX_SLICES || r.max_depth > MAX_DEPTH {
             bail!(

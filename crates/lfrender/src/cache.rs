@@ -107,8 +107,9 @@ impl CacheGrid {
     /// at least `glossy_share` times the angle the camera grid spans seen from `p`, and at
     /// least `glossy_min_width`.
     pub fn shares_glossy(&self, p: Vec3, width: f32) -> bool {
-        let dist = (p.as_dvec3() - self.origin).length();
-        width >= self.min_shared_width && width as f64 * dist >= self.shared_lobe_span
+        // The floor first: it settles a narrow lobe without the square root (once per sample).
+        width >= self.min_shared_width
+            && width as f64 * (p.as_dvec3() - self.origin).length() >= self.shared_lobe_span
     }
 
     /// The cells of point `p` with shading normal `n` on material `material`: at the level
