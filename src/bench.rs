@@ -149,7 +149,7 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
     println!(
         "scene | shading | PSNR linear dB: vs reference (vs truth) | PSNR 8-bit dB: vs reference \
          (vs truth) | photo residual (8-bit levels) | s per scene | per-view noise share: \
-         linear / 8-bit | pixels given adaptive samples"
+         linear / 8-bit | pixels given adaptive samples | cache noise share: linear / 8-bit"
     );
     for &index in scenes {
         let (desc, scene) = generate_scene(&cfg, index, None)?;
@@ -270,31 +270,61 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
             let (again, _) = render(&RenderSettings { seed, ..settings }, center);
             let again = again.pixels;
             write(&format!("{shading:?}_again").to_lowercase(), &again)?;
-            let between = mse(&c, &again);
-            let share = |k: usize| {
+            let share = |between: [f64; 2], k: usize| {
                 let to_truth = mse_to_truth(to_reference[k], own_noise[k]);
-                100.0 * per_view_share(between[k], to_truth)
+                100.0 * noise_share(between[k], to_truth)
+            };
+            let per_view = mse(&c, &again);
+            // The centre view again from the same camera seeds but a cache filled from other
+            // seeds: the two differ by the cache's noise alone; what neither noise explains is
+            // the cache's bias (its blur over a cell, the fit of the shared lobes).
+            let cache_share = match &cache {
+                None => "–".to_owned(),
+                Some(_) => {
+                    let fill = RenderSettings {
+                        seed: settings.seed ^ CACHE_SALT,
+                        ..settings
+                    };
+                    let other = job.fill_cache(&scene, cam, &fill, &counter);
+                    let out = scene.render_view_with(
+                        cam,
+                        &desc.slices,
+                        &settings,
+                        center,
+                        false,
+                        Shading::read(&other),
+                        &counter,
+                    );
+                    write("shared_other_cache", &out.image.pixels)?;
+                    let between = mse(&c, &out.image.pixels);
+                    format!("{:.0} % / {:.0} %", share(between, 0), share(between, 1))
+                }
             };
             println!(
                 "{index} | {shading:?} | {linear} | {eight_bit} | {:.2} | {scene_s:.1} | {:.0} % / {:.0} % \
-                 | {refined:.1} %",
+                 | {refined:.1} % | {cache_share}",
                 photo_residual(&c, &adjacent, &disparity, &gt.modes, [w, h], exposure, tone),
-                share(0),
-                share(1),
+                share(per_view, 0),
+                share(per_view, 1),
             );
         }
     }
     Ok(())
 }
 
-/// Salt of the second render of a view that measures its own noise ([`per_view_share`]).
+/// Salt of the second render of a view that measures its own noise ([`noise_share`]).
 const PER_VIEW_SALT: u64 = 0x005E_C04D;
 
-/// The share of a render's error against the truth that is its view's own noise, from the
-/// squared difference of two renders that differ only in their camera seeds: shared shading's
-/// two renders read the same cache, so they differ by twice the per-view noise's variance; the
-/// rest of the error (the cache's noise and bias) is common to both and to every view.
-fn per_view_share(mse_between_renders: f64, mse_vs_truth: f64) -> f64 {
+/// Salt of the second cache's fill seeds, which measures the cache's noise ([`noise_share`]).
+const CACHE_SALT: u64 = 0x00CA_C4E5;
+
+/// The share of a render's error against the truth that is one source's noise, from the
+/// squared difference of two renders that differ only in that source's seeds: they differ by
+/// twice its variance, and the rest of the error is common to both. Shared shading's two
+/// renders of a view read the same cache for its per-view noise (the rest, the cache's noise
+/// and bias, is common to every view), and the same camera seeds with caches of their own for
+/// the cache's noise.
+fn noise_share(mse_between_renders: f64, mse_vs_truth: f64) -> f64 {
     (mse_between_renders / 2.0 / mse_vs_truth).min(1.0)
 }
 
@@ -423,8 +453,8 @@ mod tests {
         let (a, b) = (render(), render());
         let truth = vec![Vec3::splat(0.5); n];
         // Per-view variance 0.04 / 3, common 0.01 / 3: the noise is 80 % of the error.
-        let share = per_view_share(mse_linear(&a, &b, 1.0), mse_linear(&a, &truth, 1.0));
+        let share = noise_share(mse_linear(&a, &b, 1.0), mse_linear(&a, &truth, 1.0));
         assert!((share - 0.8).abs() < 0.01, "{share}");
-        assert_eq!(per_view_share(2.0, 0.5), 1.0, "never above the whole error");
+        assert_eq!(noise_share(2.0, 0.5), 1.0, "never above the whole error");
     }
 }

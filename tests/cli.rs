@@ -404,7 +404,8 @@ fn rays_through_windows_and_doors_end_on_a_surface() {
 }
 
 /// `lfgen bench --quality` end to end at a tiny size: the converged row and both shadings, each
-/// with the share of its error that is its view's own noise. The independent estimator has no
+/// with the share of its error that is its view's own noise, and shared shading's cache noise
+/// share. The independent estimator has no
 /// shared part, so all of its error is its own: at 128² the bench finds 100 % (linear); on
 /// 576 pixels a few fireflies make the estimate itself noisy (68 % here), while a second render
 /// that repeated the first one's samples would give 0 %. An image size below the bench's
@@ -423,16 +424,25 @@ fn the_quality_bench_scores_both_shadings_with_their_error_budget() {
         line.split(" | ").map(str::to_owned).collect()
     };
     assert!(row("converged").len() >= 5, "{table}");
-    let share = |cells: &[String]| -> f64 {
-        let linear = cells[6].split(" % / ").next().unwrap();
+    let share = |cells: &[String], column: usize| -> f64 {
+        let linear = cells[column].split(" % / ").next().unwrap();
         linear
             .parse()
-            .unwrap_or_else(|_| panic!("share {:?}", cells[6]))
+            .unwrap_or_else(|_| panic!("share {:?}", cells[column]))
     };
-    let independent = row("Independent");
-    assert!(share(&independent) >= 50.0, "{table}");
-    assert!((0.0..=100.0).contains(&share(&row("Shared"))), "{table}");
-    for name in ["reference", "shared", "shared_again", "independent"] {
+    let (independent, shared) = (row("Independent"), row("Shared"));
+    assert!(share(&independent, 6) >= 50.0, "{table}");
+    assert!((0.0..=100.0).contains(&share(&shared, 6)), "{table}");
+    // The cache's noise: shared shading's alone (the independent estimator reads no cache).
+    assert!((0.0..=100.0).contains(&share(&shared, 8)), "{table}");
+    assert_eq!(independent[8], "–", "{table}");
+    for name in [
+        "reference",
+        "shared",
+        "shared_again",
+        "shared_other_cache",
+        "independent",
+    ] {
         let path = images.path().join(format!("scene0_{name}.png"));
         assert!(path.exists(), "{} missing", path.display());
     }
