@@ -218,6 +218,10 @@ pub struct RenderConfig {
     /// Shared shading: light samples each fill path takes at its first vertex, averaged
     /// (see `render::cache::CacheGrid::fill_light_samples`).
     pub fill_light_samples: u32,
+    /// Shared shading: shrink each cache cell's irradiance towards the next coarser level's
+    /// as far as the cell's own noise explains their difference (see
+    /// `render::cache::CellSums::shrunk`).
+    pub cache_shrink: bool,
     /// Average library textures seen by camera rays over one sample's footprint.
     pub texture_filter: bool,
     /// Light through smooth glass: `caustics` (default, unbiased), `shadows` or `off` (see
@@ -254,6 +258,7 @@ impl Default for RenderConfig {
             glossy_min_width: 0.1,
             fill_vertices: 5,
             fill_light_samples: 4,
+            cache_shrink: true,
             texture_filter: true,
             glass_light: GlassLight::Caustics,
             split_glass: true,

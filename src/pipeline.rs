@@ -89,6 +89,7 @@ impl RenderJob {
                 glossy_min_width: r.glossy_min_width as f32,
                 fill_vertices: r.fill_vertices,
                 fill_light_samples: r.fill_light_samples,
+                shrink: r.cache_shrink,
             },
             texture_filter: r.texture_filter,
         }

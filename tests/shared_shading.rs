@@ -566,14 +566,9 @@ fn parallel_square_irradiance(p: Vec3, centre: Vec3, side: f64, emission: f64) -
     std::f64::consts::PI * emission * form
 }
 
-/// More light samples at a fill path's first vertex (`render.fill_light_samples`) average
-/// copies of the same MIS-weighted estimator. A black wall lit by two small lights at
-/// different distances: each cell's coupled irradiance is the closed-form irradiance of the
-/// two squares, all of it direct; one light sample picks one light (by power over distance)
-/// and carries nearly all of it, so its choice and point are the cells' noise. With eight the
-/// cells stay on the closed form and scatter less than half as much.
-#[test]
-fn more_fill_light_samples_stay_on_the_closed_form_and_cut_its_noise() {
+/// A black wall (z = −3) lit by two small square lights at different distances, seen by a
+/// 3×3 grid, and its closed-form coupled irradiance: all of it direct, from the two squares.
+fn two_lights() -> (Harness, impl Fn(Vec3) -> f64) {
     let cam = camera([64, 64], [3, 3], 35.0, DVec3::new(0.0, 1.5, 2.0));
     let (side, emission) = (0.4, 20.0);
     let centres = [Vec3::new(-1.0, 1.0, -1.0), Vec3::new(1.2, 2.0, -0.4)];
@@ -589,27 +584,40 @@ fn more_fill_light_samples_stay_on_the_closed_form_and_cut_its_noise() {
     );
     let parts = vec![wall, light(centres[0]), light(centres[1])];
     let h = Harness::new(scene(cam, [1.0, 5.2], [0.0; 3], parts));
-    let s = settings(1, 5);
-    let truth = |p: Vec3| {
+    let truth = move |p: Vec3| {
         (centres.iter())
             .map(|&c| parallel_square_irradiance(p, c, side, emission))
             .sum::<f64>()
     };
+    (h, truth)
+}
+
+/// The mean and rms scatter of the two lights' wall cells about the closed form, filled with
+/// one sample per pixel of every view and `params`.
+fn two_lights_spread(params: CacheParams, what: &str) -> (f64, f64) {
+    let (h, truth) = two_lights();
+    let ratios = back_wall_ratios(&h.cache_with(&settings(1, 5), 1, params), truth);
+    let (mean, rms) = mean_and_scatter(&ratios);
+    let n = ratios.len();
+    eprintln!("{what}: {n} cells, mean {mean:.4} of the closed form, rms {rms:.4}");
+    assert!(n > 200, "{n} cells");
+    (mean, rms)
+}
+
+/// More light samples at a fill path's first vertex (`render.fill_light_samples`) average
+/// copies of the same MIS-weighted estimator. On the two lights' wall each cell's coupled
+/// irradiance is known in closed form; one light sample picks one light (by power over
+/// distance) and carries nearly all of it, so its choice and point are the cells' noise. With
+/// eight the cells stay on the closed form and scatter less than half as much.
+#[test]
+fn more_fill_light_samples_stay_on_the_closed_form_and_cut_its_noise() {
     let spread = |fill_light_samples| {
         let params = CacheParams {
             fill_vertices: 1,
             fill_light_samples,
             ..common::CACHE
         };
-        let ratios = back_wall_ratios(&h.cache_with(&s, 1, params), truth);
-        let (mean, rms) = mean_and_scatter(&ratios);
-        let n = ratios.len();
-        eprintln!(
-            "fill_light_samples {fill_light_samples}: {n} cells, mean {mean:.4} of the closed \
-             form, rms {rms:.4}"
-        );
-        assert!(n > 200, "{n} cells");
-        (mean, rms)
+        two_lights_spread(params, &format!("fill_light_samples {fill_light_samples}"))
     };
     let ((mean_one, one), (mean_eight, eight)) = (spread(1), spread(8));
     for mean in [mean_one, mean_eight] {
@@ -618,5 +626,38 @@ fn more_fill_light_samples_stay_on_the_closed_form_and_cut_its_noise() {
     assert!(
         eight < 0.5 * one,
         "rms {eight:.4} with 8 light samples vs {one:.4}"
+    );
+}
+
+/// Shrinking the cells towards their coarser levels (`render.cache_shrink`) against two
+/// closed forms. In the furnace every cell's coupled irradiance is the same: the cells stay
+/// on it and scatter far less, pooling the coarser levels' samples. On the two lights' wall
+/// it varies several-fold within a metre, steepest under the near light: the cells stay on
+/// the closed form there too (a shrink that blurred the falloff would move them) and still
+/// scatter less.
+#[test]
+fn shrunk_cells_stay_on_the_closed_forms_and_scatter_less() {
+    let h = furnace();
+    let s = settings(1, 5);
+    let shrink = |on: bool| CacheParams {
+        shrink: on,
+        ..common::CACHE
+    };
+    let plain = furnace_scatter(&h, &s, shrink(false), "furnace");
+    let shrunk = furnace_scatter(&h, &s, shrink(true), "furnace, shrunk");
+    assert!(
+        shrunk < 0.7 * plain,
+        "furnace rms {shrunk:.4} shrunk vs {plain:.4}"
+    );
+    let lights = |on| CacheParams {
+        fill_vertices: 1,
+        ..shrink(on)
+    };
+    let (_, plain) = two_lights_spread(lights(false), "two lights");
+    let (mean, shrunk) = two_lights_spread(lights(true), "two lights, shrunk");
+    assert!((mean - 1.0).abs() < 0.01, "mean {mean}");
+    assert!(
+        shrunk < 0.8 * plain,
+        "two lights rms {shrunk:.4} shrunk vs {plain:.4}"
     );
 }

@@ -48,6 +48,7 @@ pub const CACHE: CacheParams = CacheParams {
     glossy_min_width: 0.1,
     fill_vertices: 5,
     fill_light_samples: 1,
+    shrink: false,
 };
 
 /// Focal length in pixels, from docs/conventions.md, Camera (not from the code under test).

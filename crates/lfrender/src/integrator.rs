@@ -4,7 +4,7 @@
 
 use super::RenderScene;
 use super::bsdf::{Frame, Lobes, power_heuristic};
-use super::cache::{COARSER, CacheGrid, Estimate, MAX_FILL_VERTICES, RadianceCache};
+use super::cache::{Anchor, COARSER, CacheGrid, Estimate, MAX_FILL_VERTICES, RadianceCache};
 use super::geometry::Hit;
 use super::sampler::Sampler;
 use glam::{Vec2, Vec3};
@@ -126,9 +126,9 @@ struct Vertex<'a> {
 /// What a traced path found.
 pub struct Traced {
     pub radiance: Vec3,
-    /// With [`Shading::Fill`]: the cells (one per level) of the first non-delta vertex and the
-    /// estimate made there (none if the path never reached one).
-    pub fill: Option<([u64; COARSER + 1], Estimate)>,
+    /// With [`Shading::Fill`]: the cells (one per level) of the first non-delta vertex, the
+    /// estimate made there and where it lies (none if the path never reached one).
+    pub fill: Option<([u64; COARSER + 1], Estimate, Anchor)>,
     /// With [`Shading::Fill`]: the coupled irradiance estimated at later surface vertices.
     pub later: Later,
 }
@@ -363,7 +363,12 @@ impl RenderScene {
                         // before it is not part of it.
                         let glossy = self.fills_glossy(grid, p, &bsdf, wo_l, sampler);
                         let cells = grid.keys(p, frame.n, s.material);
-                        fill = Some((cells, glossy));
+                        let anchor = Anchor {
+                            p,
+                            n: frame.n,
+                            material: s.material,
+                        };
+                        fill = Some((cells, glossy, anchor));
                         first_depth = depth;
                         light_samples = grid.fill_light_samples;
                         (radiance, beta, lobes) = match glossy {
@@ -518,7 +523,7 @@ impl RenderScene {
         };
         Traced {
             radiance,
-            fill: fill.map(|(cells, glossy)| (cells, estimate(glossy))),
+            fill: fill.map(|(cells, glossy, at)| (cells, estimate(glossy), at)),
             later,
         }
     }

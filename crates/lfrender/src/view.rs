@@ -256,8 +256,8 @@ impl RenderScene {
                 (self.geometry).closest(&self.materials, ray.origin, ray.dir, f32::INFINITY, key);
             let fill = Shading::Fill(grid);
             let traced = self.trace(&s.path, ray.origin, ray.dir, first, &mut sampler, fill);
-            if let Some((cells, estimate)) = traced.fill {
-                sums.add(&cells, estimate, uv);
+            if let Some((cells, estimate, at)) = traced.fill {
+                sums.add(&cells, estimate, uv, at);
             }
             for (cells, irradiance) in traced.later.estimates() {
                 sums.add_later(cells, irradiance);
