@@ -477,9 +477,14 @@ pub struct RadianceCache {
 
 impl RadianceCache {
     fn new(grid: CacheGrid, cells: KeyMap<Cell>) -> Self {
-        static NEXT_ID: AtomicU64 = AtomicU64::new(0);
-        let id = NEXT_ID.fetch_add(1, Ordering::Relaxed);
+        let id = Self::next_id();
         Self { grid, cells, id }
+    }
+
+    /// A process-unique id ([`Corners`]).
+    fn next_id() -> u64 {
+        static NEXT_ID: AtomicU64 = AtomicU64::new(0);
+        NEXT_ID.fetch_add(1, Ordering::Relaxed)
     }
 
     /// Shrinks every cell's irradiance towards the next coarser level's field
@@ -508,7 +513,7 @@ impl RadianceCache {
                 self.cells.get_mut(&key).expect("a filled cell").irradiance = Some(irradiance);
             }
             // Lookups remember cells per cache id: the changed cells are a new cache.
-            self.id = Self::new(self.grid, KeyMap::default()).id;
+            self.id = Self::next_id();
         }
     }
 
