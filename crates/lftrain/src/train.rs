@@ -16,7 +16,7 @@ use crate::loader::{Loader, PoolConfig, TrainBatch};
 use crate::log::{Record, TrainLog};
 use crate::loss::loss;
 use crate::model::{Network, StackNet, decode};
-use crate::run::{CONFIG_FILE, RunDir, RunState, build_net, grid_of};
+use crate::run::{CONFIG_FILE, RunDir, RunState, build_net, grid_of, seeded};
 use crate::sample::Batch;
 use crate::shift_loss::{ShiftTargets, epishift_loss};
 use crate::shift_sample::ShiftBatch;
@@ -113,12 +113,12 @@ pub fn train(mut cfg: TrainConfig, args: &TrainArgs) -> Result<TrainSummary> {
         eprintln!("lftrain: training on {base:?}");
     }
     let device = base.clone().autodiff();
-    base.seed(cfg.seed);
     let (net, optim) = if args.resume {
         let net = run.load_net(&cfg, grid, &device)?;
         (net, run.load_optimizer(adam(&cfg))?)
     } else {
-        (build_net(&cfg, grid, &device), adam(&cfg))
+        let net = seeded(&base, cfg.seed, || build_net(&cfg, grid, &device));
+        (net, adam(&cfg))
     };
     let loader = Loader::start(train_scenes, cfg.clone(), args.pool, state.step as u64)?;
     let mut log = TrainLog::open(&args.out, args.resume, state.step)?;
@@ -296,7 +296,6 @@ fn progress(total: usize, done: usize, quiet: bool) -> ProgressBar {
 pub fn bench_steps(cfg: &TrainConfig, grid: usize, steps: usize) -> Result<(f64, usize)> {
     let base = default_device();
     let device = base.clone().autodiff();
-    base.seed(cfg.seed);
     let (p, b, modes) = (cfg.patch, cfg.batch, cfg.target_modes());
     let noise = |len: usize, scale: f32| -> Vec<f32> {
         (0..len)
@@ -335,7 +334,7 @@ pub fn bench_steps(cfg: &TrainConfig, grid: usize, steps: usize) -> Result<(f64,
     let mut trainer = Trainer {
         cfg: cfg.clone(),
         input: StackInput::of(cfg),
-        net: build_net(cfg, grid, &device),
+        net: seeded(&base, cfg.seed, || build_net(cfg, grid, &device)),
         optim: adam(cfg),
         device,
         base,

@@ -6,6 +6,7 @@ use burn::prelude::*;
 use burn::tensor::TensorData;
 use lftrain::config::{ClassTarget, EpiShiftConfig};
 use lftrain::epishift::EpiShiftNet;
+use lftrain::run::seeded;
 use lftrain::shift_loss::{ShiftTargets, epishift_loss};
 use lftrain::shift_predict::{ShiftMaps, run_shifts, scene_shifts};
 use lftrain::synthetic::TwoPlanes;
@@ -76,9 +77,8 @@ fn an_integer_shift_of_the_input_moves_the_classification_peak_by_as_much() {
     // network's C^{s+k} on B equals C^s on A (away from the image border, where the clipping
     // differs and the receptive field reaches it), and the per-pixel peak moves by k.
     let dev = device();
-    dev.seed(7);
     let cfg = tiny(1);
-    let net = EpiShiftNet::new(&cfg, 15, &dev);
+    let net = seeded(&dev, 7, || EpiShiftNet::new(&cfg, 15, &dev));
     let a = TwoPlanes::new(5, 72);
     let k = 2;
     let b = TwoPlanes {

@@ -7,6 +7,7 @@ use burn::tensor::TensorData;
 use lftrain::config::{CostNetwork, EseOutside, ModelKind, NetConfig, NetInput, TrainConfig};
 use lftrain::loss::{TargetTensors, dpp_bin, loss};
 use lftrain::model::{EpiNet, turn_to_reference};
+use lftrain::run::seeded;
 use lftrain::stacks::{Direction, Region, extract};
 use lftrain::synthetic::TwoPlanes;
 use lftrain::tensors::{tensor4, values};
@@ -104,7 +105,8 @@ fn default_network_has_the_parameter_counts_of_thesis_table_b1() {
         (ModelKind::Dpp, 4_778_872),
     ] {
         let c = cfg(model);
-        let net = EpiNet::new(&c.net, 27, model.out_channels(c.dpp.bins), &dev);
+        let bins = model.out_channels(c.dpp.bins);
+        let net = seeded(&dev, c.seed, || EpiNet::new(&c.net, 27, bins, &dev));
         // burn also counts batch norm's running mean and variance, which are not trained.
         let norm_channels = 2 * 3 * 70 + 7 * 280;
         assert_eq!(net.num_params() - 2 * norm_channels, want, "{model:?}");
@@ -124,9 +126,8 @@ fn tiny_net() -> NetConfig {
 #[test]
 fn gradient_matches_finite_differences() {
     let dev = device().autodiff();
-    dev.seed(3);
     let c = cfg(ModelKind::Upr);
-    let net = EpiNet::new(&tiny_net(), 9, 2, &dev);
+    let net = seeded(&dev, 3, || EpiNet::new(&tiny_net(), 9, 2, &dev));
     let shape = [2, 9, 6, 6];
     let len = shape.iter().product::<usize>();
     let input: Vec<f32> = (0..len).map(|i| ((i * 37 % 101) as f32) / 101.0).collect();
@@ -346,7 +347,7 @@ fn every_model_writes_a_posterior_lfeval_reads() {
             },
             ..TrainConfig::default()
         };
-        let net = lftrain::run::build_net(&c, 3, &dev);
+        let net = seeded(&dev, c.seed, || lftrain::run::build_net(&c, 3, &dev));
         let pred = lftrain::predict::predict(&c, &net, &lf, &dev);
         if matches!(model, ModelKind::Dpp | ModelKind::Ese) {
             point_follows_the_config(c.clone(), &net, &lf, &dev);
@@ -385,8 +386,7 @@ fn every_model_writes_a_posterior_lfeval_reads() {
 #[test]
 fn frozen_batch_norm_trains_like_inference_and_keeps_its_statistics() {
     let dev = device().autodiff();
-    dev.seed(5);
-    let net = EpiNet::new(&tiny_net(), 9, 1, &dev);
+    let net = seeded(&dev, 5, || EpiNet::new(&tiny_net(), 9, 1, &dev));
     let shape = [2, 9, 6, 6];
     let input: Vec<f32> = (0..2 * 9 * 36)
         .map(|i| ((i * 53 % 97) as f32) / 97.0)
@@ -453,10 +453,9 @@ fn test_rotations_turn_the_prediction_with_the_light_field() {
     use lftrain::lightfield::{LightField, rotate_plane};
     use lftrain::predict::run_net;
     let dev = device();
-    dev.seed(9);
     // Eight output planes: an untrained net's ReLU before the last convolution leaves some
     // of them constant, which would pass any check.
-    let net = EpiNet::new(&tiny_net(), 9, 8, &dev);
+    let net = seeded(&dev, 9, || EpiNet::new(&tiny_net(), 9, 8, &dev));
     // A non-square light field, so a width/height mix-up cannot pass.
     let (w, h) = (12, 8);
     let lf = LightField::from_fn(3, w, h, |u, v, x, y| {
@@ -568,4 +567,43 @@ fn decode_takes_the_soft_argmin_of_the_hypotheses() {
         values(decode(raw, ModelKind::Upr, &StackInput::Views)),
         same
     );
+}
+
+/// Every float parameter of `net`, in visiting order.
+fn weights<M: burn::module::Module>(net: &M) -> Vec<f32> {
+    struct Collect(Vec<f32>);
+    impl burn::module::ModuleVisitor for Collect {
+        fn visit_float<const D: usize>(&mut self, param: &burn::module::Param<Tensor<D>>) {
+            self.0
+                .extend(param.val().into_data().try_to_vec::<f32>().unwrap());
+        }
+    }
+    let mut collect = Collect(Vec::new());
+    net.visit(&mut collect);
+    collect.0
+}
+
+/// Networks built at once in one process (tests in parallel, two trainings) get the weights
+/// their seed gives alone: burn has one generator per process and draws a parameter on its
+/// first use, so `seeded` draws them all under one lock.
+#[test]
+fn networks_built_at_once_get_the_weights_of_their_seeds() {
+    let dev = device();
+    let build = |seed| seeded(&dev, seed, || EpiNet::new(&tiny_net(), 9, 2, &dev));
+    let alone = weights(&build(1));
+    let at_once: Vec<Vec<f32>> = std::thread::scope(|s| {
+        let threads: Vec<_> = (0..8)
+            .map(|i| {
+                let build = &build;
+                s.spawn(move || weights(&build(1 + i % 2)))
+            })
+            .collect();
+        threads.into_iter().map(|t| t.join().unwrap()).collect()
+    });
+    for (i, w) in at_once.iter().enumerate() {
+        match i % 2 {
+            0 => assert!(w == &alone, "thread {i}: seed 1 gave other weights"),
+            _ => assert!(w != &alone, "thread {i}: seed 2 gave seed 1's weights"),
+        }
+    }
 }
