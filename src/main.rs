@@ -86,7 +86,7 @@ struct ConfigArgs {
     /// Config file (default: ./generator.toml if present, else built-in defaults).
     #[arg(long)]
     config: Option<PathBuf>,
-    /// Named override bundle applied before --set: full, quick, wide (repeatable).
+    /// Named override bundle applied before --set: full, quick, wide, clean (repeatable).
     #[arg(long)]
     preset: Vec<String>,
     /// Override any config key, e.g. --set camera.resolution=[64,64] (repeatable).

@@ -90,6 +90,7 @@ impl RenderJob {
                 fill_vertices: r.fill_vertices,
                 fill_light_samples: r.fill_light_samples,
                 shrink: r.cache_shrink,
+                final_gather: r.final_gather,
             },
             texture_filter: r.texture_filter,
         }
@@ -99,7 +100,7 @@ impl RenderJob {
     /// colour, the fill pass of shared shading, and the GT's own samples where it has them.
     pub fn samples_per_pixel(&self, views: u32) -> u64 {
         let fill = match self.shading {
-            ShadingMode::Shared => self.fill_spp(views),
+            ShadingMode::Shared => self.fill_spp(views) * (1 + self.cache.final_gather as u32),
             ShadingMode::Independent => 0,
         };
         let gt_views = match self.gt_views {
@@ -434,10 +435,14 @@ mod tests {
     }
 
     #[test]
-    fn samples_per_pixel_count_the_fill_and_the_gts_own_samples() {
+    fn samples_per_pixel_count_the_fills_and_the_gts_own_samples() {
         // 81 views × (16 + 4 fill); the centre GT adds 64 of its own.
         assert_eq!(job(16, 4, 0).samples_per_pixel(81), 81 * 20);
         assert_eq!(job(16, 4, 64).samples_per_pixel(81), 81 * 20 + 64);
         assert_eq!(job(16, 4, 16).samples_per_pixel(81), 81 * 20);
+        // A final gather fills the cache twice.
+        let mut gather = job(16, 4, 0);
+        gather.cache.final_gather = true;
+        assert_eq!(gather.samples_per_pixel(81), 81 * 24);
     }
 }

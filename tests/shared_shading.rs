@@ -629,6 +629,27 @@ fn more_fill_light_samples_stay_on_the_closed_form_and_cut_its_noise() {
     );
 }
 
+/// A final gather (`render.final_gather`): a second fill pass whose paths read the first
+/// pass's cache at their second surface. In the furnace every cell's coupled irradiance is
+/// known: the cells stay on it with the gathered estimates added (one weighted other than the
+/// path it stands for, or reading the prior at the wrong vertex, would move them; at 12
+/// bounces the one more that the prior's light adds is 0.5¹² of it) and scatter less.
+#[test]
+fn a_final_gather_stays_on_the_furnace_and_cuts_its_noise() {
+    let h = furnace();
+    let s = settings(1, 12);
+    let gather = |on: bool| CacheParams {
+        final_gather: on,
+        ..common::CACHE
+    };
+    let plain = furnace_scatter(&h, &s, gather(false), "furnace, 12 bounces");
+    let gathered = furnace_scatter(&h, &s, gather(true), "furnace, 12 bounces, gathered");
+    assert!(
+        gathered < 0.9 * plain,
+        "furnace rms {gathered:.4} gathered vs {plain:.4}"
+    );
+}
+
 /// Shrinking the cells towards their coarser levels (`render.cache_shrink`) against two
 /// closed forms. In the furnace every cell's coupled irradiance is the same: the cells stay
 /// on it and scatter far less, pooling the coarser levels' samples. On the two lights' wall

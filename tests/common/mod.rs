@@ -49,6 +49,7 @@ pub const CACHE: CacheParams = CacheParams {
     fill_vertices: 5,
     fill_light_samples: 1,
     shrink: false,
+    final_gather: false,
 };
 
 /// Focal length in pixels, from docs/conventions.md, Camera (not from the code under test).

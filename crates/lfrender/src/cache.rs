@@ -73,6 +73,9 @@ pub struct CacheParams {
     /// Shrink each cell's irradiance towards the next coarser level's as far as its own
     /// noise explains their difference ([`CellSums::shrunk`]).
     pub shrink: bool,
+    /// A second fill pass whose paths read the first pass's cache at their second surface
+    /// (a final gather); its estimates join the first pass's in every cell.
+    pub final_gather: bool,
 }
 
 /// The most vertices of one fill path that feed the cache.
@@ -401,8 +404,9 @@ impl CacheSums {
     }
 
     /// The means per cell, their irradiance shrunk towards the next coarser level's
-    /// ([`CellSums::shrunk`]) if the grid says so.
-    pub fn finish(self, grid: CacheGrid) -> RadianceCache {
+    /// ([`CellSums::shrunk`]) if the grid says so. The sums stay: a final gather reads this
+    /// cache and adds its estimates to them.
+    pub fn finish(&self, grid: CacheGrid) -> RadianceCache {
         let means = (self.cells.iter())
             .map(|(&k, sums)| (k, sums.mean()))
             .collect();
@@ -633,6 +637,7 @@ mod tests {
         fill_vertices: 1,
         fill_light_samples: 1,
         shrink: false,
+        final_gather: false,
     };
 
     /// Where the estimates of a test with made-up keys lie: anywhere (`PARAMS` shrinks

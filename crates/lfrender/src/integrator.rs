@@ -92,6 +92,16 @@ pub enum Shading<'a> {
         cache: &'a RadianceCache,
         view: Vec2,
     },
+    /// A final gather: as `Fill` at the first non-delta vertex, whose estimate then reads
+    /// `prior` at the path's next non-delta vertex as `Read` does (the path traces on where
+    /// `prior` has no cell). Its light beyond that vertex is the prior's smooth value, not
+    /// one more path's noise, so the estimate has about half a fill path's variance; it adds
+    /// no later-vertex estimates. `view` as for `Read`.
+    Gather {
+        grid: &'a CacheGrid,
+        prior: &'a RadianceCache,
+        view: Vec2,
+    },
 }
 
 impl<'a> Shading<'a> {
@@ -107,6 +117,7 @@ impl<'a> Shading<'a> {
     pub fn seen_from(self, view: Vec2) -> Self {
         match self {
             Self::Read { cache, .. } => Self::Read { cache, view },
+            Self::Gather { grid, prior, .. } => Self::Gather { grid, prior, view },
             other => other,
         }
     }
@@ -126,8 +137,9 @@ struct Vertex<'a> {
 /// What a traced path found.
 pub struct Traced {
     pub radiance: Vec3,
-    /// With [`Shading::Fill`]: the cells (one per level) of the first non-delta vertex, the
-    /// estimate made there and where it lies (none if the path never reached one).
+    /// With [`Shading::Fill`] or [`Shading::Gather`]: the cells (one per level) of the first
+    /// non-delta vertex, the estimate made there and where it lies (none if the path never
+    /// reached one).
     pub fill: Option<([u64; COARSER + 1], Estimate, Anchor)>,
     /// With [`Shading::Fill`]: the coupled irradiance estimated at later surface vertices.
     pub later: Later,
@@ -286,12 +298,18 @@ impl RenderScene {
         let mut later = Later::default();
         // The loop depth of the fill's first vertex.
         let mut first_depth = 0;
-        // The grid of a fill path, whose later vertices open estimates of their own.
-        let fill_grid = match shading {
-            Shading::Fill(grid) => Some(grid),
-            _ => None,
+        // The grid of a fill path, whose later vertices open estimates of their own (a
+        // gathering path's do not: their light is the prior's).
+        let (fill_grid, read) = match shading {
+            Shading::Independent => (None, None),
+            Shading::Fill(grid) => (Some(grid), None),
+            Shading::Read { cache, view } => (None, Some((cache, view))),
+            Shading::Gather { grid, prior, view } => (Some(grid), Some((prior, view))),
         };
-        let later_max = fill_grid.map_or(0, |grid| grid.fill_vertices as usize - 1);
+        let later_max = match (shading, fill_grid) {
+            (Shading::Fill(_), Some(grid)) => grid.fill_vertices as usize - 1,
+            _ => 0,
+        };
         // Camera-ray length so far while only delta vertices were passed (texture filter).
         let mut camera_length = Some(start.camera_length);
         // Whether the path left a surface vertex (one with a light sample) and has refracted
@@ -356,9 +374,11 @@ impl RenderScene {
                 && bsdf.specular_probability(wo_l) <= LATER_MAX_GLOSSY;
             if pending && !bsdf.is_delta() {
                 pending = false;
-                match shading {
-                    Shading::Independent => {}
-                    Shading::Fill(grid) => {
+                // A fill path opens its estimate at its first such vertex; a reading path (a
+                // gathering one at its next) reads there.
+                match (fill_grid.filter(|_| fill.is_none()), read) {
+                    (None, None) => {}
+                    (Some(grid), _) => {
                         // From here the path estimates I(p), or the shared glossy term: light
                         // before it is not part of it.
                         let glossy = self.fills_glossy(grid, p, &bsdf, wo_l, sampler);
@@ -383,7 +403,7 @@ impl RenderScene {
                             false => (Vec3::ZERO, Vec3::ONE, Lobes::CoupledIrradiance),
                         };
                     }
-                    Shading::Read { cache, view } => {
+                    (None, Some((cache, view))) => {
                         if let Some(c) = cache.lookup(p, frame.n, s.material) {
                             radiance += beta * bsdf.diffuse_out(wo_l) * c.irradiance;
                             let q = bsdf.specular_probability(wo_l);
@@ -491,6 +511,8 @@ impl RenderScene {
             // A glossy continuation from a cached vertex reads the cache again at its next
             // non-delta vertex, as a camera path through glass does: only the lobe is per view.
             pending |= lobes == Lobes::Specular && matches!(shading, Shading::Read { .. });
+            // A gathering path reads the prior at its next non-delta vertex.
+            pending |= matches!(shading, Shading::Gather { .. }) && depth == first_depth;
             arrival = Arrival {
                 pdf: bs.pdf * select,
                 is_delta: bs.is_delta,

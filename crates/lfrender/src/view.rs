@@ -171,11 +171,22 @@ struct Band {
 /// Salt of the fill pass's sample streams, so they are not the render's own.
 const FILL_STREAM: u64 = 0xF111_CACE;
 
+/// One pixel of a fill pass: (view, x, y), the view's grid position, and the pass's stream.
+#[derive(Clone, Copy)]
+struct FillPixel {
+    at: (u32, u32, u32),
+    uv: Vec2,
+    stream: u64,
+}
+
 /// Stream offset of a pixel's path decisions. Pixel positions and stochastic-transparency keys
 /// come from the pixel's camera stream alone, so the ground truth (built from those rays) is the
 /// same whatever the shading mode draws along the path: an independent render and a shared one
 /// write byte-identical `modes.exr`.
 const PATH_STREAM: u64 = 0xA7B5_7EA3;
+
+/// Salt of the final gather's camera and path streams (its own samples, not the fill's again).
+const GATHER_STREAM: u64 = 0x6A7E_0F11;
 
 /// Salt of the ground truth's own camera and path streams when `gt_spp` differs from `spp`.
 const GT_STREAM: u64 = 0x6700_57EA;
@@ -200,7 +211,8 @@ impl RenderScene {
     }
 
     /// Fills the shared-shading cache from `spp` samples per pixel of every view of `cam`
-    /// (views and bands merged in order: the same sums for any thread count).
+    /// (views and bands merged in order: the same sums for any thread count), and as many
+    /// again gathering from that cache if `params.final_gather`.
     pub fn fill_cache(
         &self,
         cam: &LightFieldCamera,
@@ -210,19 +222,51 @@ impl RenderScene {
         samples_done: &AtomicU64,
     ) -> RadianceCache {
         let grid = CacheGrid::new(cam, params);
+        let fill = Shading::Fill(&grid);
+        let mut sums = self.fill_pass(cam, settings, spp, fill, FILL_STREAM, samples_done);
+        if params.final_gather {
+            let prior = sums.finish(grid);
+            let view = Vec2::ZERO;
+            let gather = Shading::Gather {
+                grid: &grid,
+                prior: &prior,
+                view,
+            };
+            let gathered = self.fill_pass(cam, settings, spp, gather, GATHER_STREAM, samples_done);
+            sums.merge_view(vec![gathered]);
+        }
+        sums.finish(grid)
+    }
+
+    /// The sums of one fill pass: `spp` samples per pixel of every view, shaded as `fill`
+    /// says, from the camera and path streams salted by `stream`.
+    fn fill_pass(
+        &self,
+        cam: &LightFieldCamera,
+        settings: &RenderSettings,
+        spp: u32,
+        fill: Shading,
+        stream: u64,
+        samples_done: &AtomicU64,
+    ) -> CacheSums {
         let (w, h) = (cam.width(), cam.height());
         let mut all = CacheSums::default();
         for view in 0..cam.num_views() {
             let rays = cam.view_rays(view);
             let uv = grid_position(cam, view);
+            let shading = fill.seen_from(uv);
             let bands: Vec<CacheSums> = (0..h.div_ceil(BAND_ROWS))
                 .into_par_iter()
                 .map(|b| {
                     let mut sums = CacheSums::default();
                     for y in b * BAND_ROWS..((b + 1) * BAND_ROWS).min(h) {
                         for x in 0..w {
-                            let pixel = (view, x, y);
-                            self.fill_pixel(&rays, settings, &grid, pixel, spp, &mut sums, uv);
+                            let pixel = FillPixel {
+                                at: (view, x, y),
+                                uv,
+                                stream,
+                            };
+                            self.fill_pixel(&rays, settings, shading, pixel, spp, &mut sums);
                         }
                         samples_done.fetch_add(w as u64 * spp as u64, Ordering::Relaxed);
                     }
@@ -231,22 +275,21 @@ impl RenderScene {
                 .collect();
             all.merge_view(bands);
         }
-        all.finish(grid)
+        all
     }
 
-    /// The fill samples of one pixel of the view at grid position `uv`.
-    #[allow(clippy::too_many_arguments)]
+    /// The fill samples of one pixel.
     fn fill_pixel(
         &self,
         rays: &ViewRays,
         s: &RenderSettings,
-        grid: &CacheGrid,
-        (view, x, y): (u32, u32, u32),
+        fill: Shading,
+        FillPixel { at, uv, stream }: FillPixel,
         spp: u32,
         sums: &mut CacheSums,
-        uv: Vec2,
     ) {
-        let scene = s.scene_index ^ FILL_STREAM;
+        let (view, x, y) = at;
+        let scene = s.scene_index ^ stream;
         let mut sampler = Sampler::new(s.seed, scene, view, x, y, spp);
         for i in 0..spp {
             let off = sampler.pixel_offset(i);
@@ -254,7 +297,6 @@ impl RenderScene {
             let key = sampler.next_key();
             let first =
                 (self.geometry).closest(&self.materials, ray.origin, ray.dir, f32::INFINITY, key);
-            let fill = Shading::Fill(grid);
             let traced = self.trace(&s.path, ray.origin, ray.dir, first, &mut sampler, fill);
             if let Some((cells, estimate, at)) = traced.fill {
                 sums.add(&cells, estimate, uv, at);
