@@ -39,20 +39,25 @@ fn same_seed_is_byte_identical_across_thread_counts_and_seeds_differ() {
     assert_ne!(fa[view], fc[view], "another seed must give another scene");
 }
 
+/// The files of one scene generated with the defaults, with `args`, and with `args` on one
+/// thread (the others use every core).
+fn one_scene_without_and_with(args: &[&str]) -> [BTreeMap<String, Vec<u8>>; 3] {
+    let (a, b, c) = (tmp(), tmp(), tmp());
+    ok(generate(a.path(), "1", &[]));
+    ok(generate(b.path(), "1", args));
+    ok(generate(
+        c.path(),
+        "1",
+        &[args, &["--threads", "1"]].concat(),
+    ));
+    [files(a.path()), files(b.path()), files(c.path())]
+}
+
 /// `render.gt_spp` through the CLI: the views stay byte for byte the same, the multimodal GT
 /// takes its own samples, and the same config stays deterministic across thread counts.
 #[test]
 fn gt_spp_changes_the_ground_truth_and_not_the_views() {
-    let (a, b, c) = (tmp(), tmp(), tmp());
-    let gt = ["--set", "render.gt_spp=16"];
-    ok(generate(a.path(), "1", &[]));
-    ok(generate(b.path(), "1", &gt));
-    ok(generate(
-        c.path(),
-        "1",
-        &[&gt[..], &["--threads", "1"]].concat(),
-    ));
-    let (fa, fb, fc) = (files(a.path()), files(b.path()), files(c.path()));
+    let [fa, fb, fc] = one_scene_without_and_with(&["--set", "render.gt_spp=16"]);
     let scene = "train/scene_0000/";
     for v in 0..9 {
         let view = format!("{scene}input_Cam{v:03}.png");
@@ -69,16 +74,7 @@ fn gt_spp_changes_the_ground_truth_and_not_the_views() {
 /// across thread counts (the gathered sums merge in the same fixed order as the fill's).
 #[test]
 fn a_final_gather_changes_the_views_not_the_ground_truth_and_stays_deterministic() {
-    let (a, b, c) = (tmp(), tmp(), tmp());
-    let gather = ["--set", "render.final_gather=true"];
-    ok(generate(a.path(), "1", &[]));
-    ok(generate(b.path(), "1", &gather));
-    ok(generate(
-        c.path(),
-        "1",
-        &[&gather[..], &["--threads", "1"]].concat(),
-    ));
-    let (fa, fb, fc) = (files(a.path()), files(b.path()), files(c.path()));
+    let [fa, fb, fc] = one_scene_without_and_with(&["--set", "render.final_gather=true"]);
     let scene = "train/scene_0000/";
     let view = format!("{scene}input_Cam004.png");
     assert!(fa[&view] != fb[&view], "the gather left {view} unchanged");

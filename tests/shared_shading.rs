@@ -636,17 +636,28 @@ fn more_fill_light_samples_stay_on_the_closed_form_and_cut_its_noise() {
 /// bounces the one more that the prior's light adds is 0.5¹² of it) and scatter less.
 #[test]
 fn a_final_gather_stays_on_the_furnace_and_cuts_its_noise() {
-    let h = furnace();
-    let s = settings(1, 12);
-    let gather = |on: bool| CacheParams {
+    let gather = |on| CacheParams {
         final_gather: on,
         ..common::CACHE
     };
-    let plain = furnace_scatter(&h, &s, gather(false), "furnace, 12 bounces");
-    let gathered = furnace_scatter(&h, &s, gather(true), "furnace, 12 bounces, gathered");
+    furnace_scatter_falls(12, gather, "gathered", 0.9);
+}
+
+/// The furnace's cells at `max_depth` with an option off and on (`with(false)`, `with(true)`):
+/// both on the closed form ([`furnace_scatter`]), and the option's scatter below `factor` of
+/// the plain one's.
+fn furnace_scatter_falls(
+    max_depth: u32,
+    with: impl Fn(bool) -> CacheParams,
+    what: &str,
+    factor: f64,
+) {
+    let (h, s) = (furnace(), settings(1, max_depth));
+    let plain = furnace_scatter(&h, &s, with(false), "furnace");
+    let on = furnace_scatter(&h, &s, with(true), &format!("furnace, {what}"));
     assert!(
-        gathered < 0.9 * plain,
-        "furnace rms {gathered:.4} gathered vs {plain:.4}"
+        on < factor * plain,
+        "furnace rms {on:.4} {what} vs {plain:.4}"
     );
 }
 
@@ -658,18 +669,11 @@ fn a_final_gather_stays_on_the_furnace_and_cuts_its_noise() {
 /// scatter less.
 #[test]
 fn shrunk_cells_stay_on_the_closed_forms_and_scatter_less() {
-    let h = furnace();
-    let s = settings(1, 5);
     let shrink = |on: bool| CacheParams {
         shrink: on,
         ..common::CACHE
     };
-    let plain = furnace_scatter(&h, &s, shrink(false), "furnace");
-    let shrunk = furnace_scatter(&h, &s, shrink(true), "furnace, shrunk");
-    assert!(
-        shrunk < 0.7 * plain,
-        "furnace rms {shrunk:.4} shrunk vs {plain:.4}"
-    );
+    furnace_scatter_falls(5, shrink, "shrunk", 0.7);
     let lights = |on| CacheParams {
         fill_vertices: 1,
         ..shrink(on)
