@@ -306,8 +306,8 @@ impl RenderScene {
             Shading::Read { cache, view } => (None, Some((cache, view))),
             Shading::Gather { grid, prior, view } => (Some(grid), Some((prior, view))),
         };
-        let later_max = match (shading, fill_grid) {
-            (Shading::Fill(_), Some(grid)) => grid.fill_vertices as usize - 1,
+        let later_max = match shading {
+            Shading::Fill(grid) => grid.fill_vertices as usize - 1,
             _ => 0,
         };
         // Camera-ray length so far while only delta vertices were passed (texture filter).

@@ -226,12 +226,8 @@ impl RenderScene {
         let mut sums = self.fill_pass(cam, settings, spp, fill, FILL_STREAM, samples_done);
         if params.final_gather {
             let prior = sums.finish(grid);
-            let view = Vec2::ZERO;
-            let gather = Shading::Gather {
-                grid: &grid,
-                prior: &prior,
-                view,
-            };
+            let (grid, prior, view) = (&grid, &prior, Vec2::ZERO);
+            let gather = Shading::Gather { grid, prior, view };
             let gathered = self.fill_pass(cam, settings, spp, gather, GATHER_STREAM, samples_done);
             sums.merge_view(vec![gathered]);
         }
