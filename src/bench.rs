@@ -24,7 +24,7 @@ pub fn run(cfg: &Config) -> Result<()> {
     cfg.camera.resolution = [BENCH_RES, BENCH_RES];
     let (desc, scene) = generate_scene(&cfg, 0, None)?;
     let cam = &desc.camera;
-    println!(
+    lfformat::say!(
         "scene: {} triangles, {} threads, {}x{} px, {} spp, max depth {}",
         scene.geometry.triangle_count(),
         rayon::current_num_threads(),
@@ -32,7 +32,7 @@ pub fn run(cfg: &Config) -> Result<()> {
         BENCH_RES,
         cfg.render.spp,
         cfg.render.max_depth
-    );
+    )?;
     let rays = cam.view_rays(cam.center_view());
     let pixels: Vec<(u32, u32)> = (0..BENCH_RES)
         .flat_map(|y| (0..BENCH_RES).map(move |x| (x, y)))
@@ -67,15 +67,15 @@ pub fn run(cfg: &Config) -> Result<()> {
         })
     });
     let n = (pixels.len() * reps as usize) as f64;
-    println!(
+    lfformat::say!(
         "closest hit (stochastic opacity): {:.2} Mrays/s",
         n / closest / 1e6
-    );
-    println!(
+    )?;
+    lfformat::say!(
         "all hits (anyhit + sort + dedupe): {:.2} Mrays/s",
         n / all / 1e6
-    );
-    println!("all_hits_cost_ratio: {:.3}", all / closest);
+    )?;
+    lfformat::say!("all_hits_cost_ratio: {:.3}", all / closest)?;
     let job = RenderJob::from_config(&cfg, "");
     let settings = job.settings(&desc);
     let counter = AtomicU64::new(0);
@@ -111,17 +111,17 @@ pub fn run(cfg: &Config) -> Result<()> {
             colour = colour.min(render(false));
             with_gt = with_gt.min(render(true));
         }
-        println!(
+        lfformat::say!(
             "{name} shading: colour only {colour:.3} s ({:.0} camera samples/s); colour + \
              {}-slice GT {with_gt:.3} s ({:.0} camera samples/s): ratio {:.3}",
             samples / colour,
             cfg.render.slices,
             samples / with_gt,
             with_gt / colour
-        );
+        )?;
         ratio = with_gt / colour;
     }
-    println!("gt_overhead_ratio: {ratio:.3}");
+    lfformat::say!("gt_overhead_ratio: {ratio:.3}")?;
     Ok(())
 }
 
@@ -146,11 +146,11 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
     }
     let mut cfg = cfg.clone();
     cfg.camera.resolution = [size, size];
-    println!(
+    lfformat::say!(
         "scene | shading | PSNR linear dB: vs reference (vs truth) | PSNR 8-bit dB: vs reference \
          (vs truth) | photo residual (8-bit levels) | s per scene | per-view noise share: \
          linear / 8-bit | pixels given adaptive samples | cache noise share: linear / 8-bit"
-    );
+    )?;
     for &index in scenes {
         let (desc, scene) = generate_scene(&cfg, index, None)?;
         let cam = &desc.camera;
@@ -228,10 +228,10 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
         let [own_linear, own_8bit] = [10.0 * (1.0 / own_noise[0]).log10(), {
             10.0 * (255.0f64 * 255.0 / own_noise[1]).log10()
         }];
-        println!(
+        lfformat::say!(
             "{index} | converged ({REFERENCE_SPP} spp) | ({own_linear:.1}) | ({own_8bit:.1}) | \
              {floor:.2} | –"
-        );
+        )?;
         for shading in [ShadingMode::Shared, ShadingMode::Independent] {
             job.shading = shading;
             let mut settings = job.settings(&desc);
@@ -300,13 +300,13 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
                     format!("{:.0} % / {:.0} %", share(between, 0), share(between, 1))
                 }
             };
-            println!(
+            lfformat::say!(
                 "{index} | {shading:?} | {linear} | {eight_bit} | {:.2} | {scene_s:.1} | {:.0} % / {:.0} % \
                  | {refined:.1} % | {cache_share}",
                 photo_residual(&c, &adjacent, &disparity, &gt.modes, [w, h], exposure, tone),
                 share(per_view, 0),
                 share(per_view, 1),
-            );
+            )?;
         }
     }
     Ok(())

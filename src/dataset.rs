@@ -153,12 +153,12 @@ fn open_library(cfg: &Config, strict: bool) -> Result<Option<AssetLibrary>> {
         return Ok(None);
     }
     let path = Path::new(&cfg.scene.catalog);
-    eprintln!("checking the asset catalogue {} …", path.display());
+    lfformat::note!("checking the asset catalogue {} …", path.display());
     let library = AssetLibrary::open(path, strict)?;
     for line in &library.skipped {
-        eprintln!("warning: {}: skipped {line}", path.display());
+        lfformat::note!("warning: {}: skipped {line}", path.display());
     }
-    eprintln!(
+    lfformat::note!(
         "{}: {} assets usable, {} skipped",
         path.display(),
         library.len(),

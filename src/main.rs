@@ -182,7 +182,7 @@ struct BenchArgs {
 
 fn main() {
     if let Err(e) = run(Cli::parse()) {
-        eprintln!("error: {e:#}");
+        lfformat::note!("error: {e:#}");
         std::process::exit(1);
     }
 }
@@ -196,19 +196,19 @@ fn run(cli: Cli) -> Result<()> {
         }
         Some(Command::Textures { count, out, seed }) => {
             let cat = lfgen::output::texture_library::write_library(&out, count, seed)?;
-            println!(
+            lfformat::say!(
                 "{}: {} textures and catalog.json",
                 out.display(),
                 cat.textures.len()
-            );
+            )?;
             Ok(())
         }
         Some(Command::Preview { dataset }) => {
             let n = lfgen::output::preview::write_contact_sheets(&dataset)?;
-            println!(
+            lfformat::say!(
                 "{}: {n} contact sheets and index.html",
                 dataset.join("previews").display()
-            );
+            )?;
             Ok(())
         }
         Some(Command::Assets {
@@ -217,16 +217,16 @@ fn run(cli: Cli) -> Result<()> {
             let summary = match a.source {
                 AssetSource::Sweethome3d => lfgen::catalog::sweethome3d::fetch(&a.out, a.nonfree)?,
             };
-            print!("{summary}");
+            lfformat::console::stdout(format_args!("{summary}"))?;
             Ok(())
         }
         Some(Command::Merge { dataset }) => {
             let m = dataset::merge(&dataset)?;
-            println!(
+            lfformat::say!(
                 "{}: manifest.json with {} verified scenes",
                 dataset.display(),
                 m.scenes.len()
-            );
+            )?;
             Ok(())
         }
         Some(Command::Bench(a)) => {
@@ -298,7 +298,7 @@ fn generate(a: GenerateArgs) -> Result<()> {
         strict: a.strict,
     };
     dataset::generate(&cfg, &opts)?;
-    eprintln!("dataset written to {}", opts.out.display());
+    lfformat::note!("dataset written to {}", opts.out.display());
     Ok(())
 }
 

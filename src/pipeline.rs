@@ -336,7 +336,7 @@ pub fn render_file(
 pub fn render_gltf(cfg: &Config, gltf: &Path, out: &Path, quiet: bool) -> Result<()> {
     let imported = crate::scene::gltf::import(gltf, &cfg.gltf_import())?;
     for w in &imported.warnings {
-        eprintln!("warning: {}: {w}", gltf.display());
+        lfformat::note!("warning: {}: {w}", gltf.display());
     }
     let mut desc = imported.desc;
     let scene = RenderScene::build_with(&desc, &imported.assets)
@@ -344,7 +344,7 @@ pub fn render_gltf(cfg: &Config, gltf: &Path, out: &Path, quiet: bool) -> Result
     frame(&mut desc, &scene, cfg).with_context(|| gltf.display().to_string())?;
     let (near, far) = (desc.slices.z_near, desc.slices.z_far);
     if cfg.camera.baseline == BaselineMode::Auto && far < 1.1 * near {
-        eprintln!(
+        lfformat::note!(
             "warning: {}: the camera sees depths {near:.3}–{far:.3} m only, so the automatic \
              baseline is {:.3} m; set camera.baseline=fixed for a physical one",
             gltf.display(),
@@ -385,7 +385,7 @@ fn publish(
     let samples = AtomicU64::new(0);
     render_scene(desc, scene, job, out, root, &samples)?;
     if !quiet {
-        eprintln!(
+        lfformat::note!(
             "{}: {} camera rays, written to {}",
             desc.name,
             samples.into_inner(),

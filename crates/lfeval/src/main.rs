@@ -199,7 +199,7 @@ fn parse_range(s: &str) -> Result<RangeArg, String> {
 
 fn main() {
     if let Err(e) = run(Cli::parse()) {
-        eprintln!("error: {e:#}");
+        lfformat::note!("error: {e:#}");
         std::process::exit(1);
     }
 }
@@ -254,8 +254,9 @@ fn evaluate(a: EvalArgs) -> Result<()> {
     let eval = pipeline::evaluate_dataset(&dataset, scenes, methods, &opts)?;
     report::write_all(&eval, &a.out)?;
     if !a.common.quiet {
-        print!("{}", report::table::main_table(&eval).to_markdown());
-        eprintln!("report written to {}", a.out.join("report.html").display());
+        let table = report::table::main_table(&eval).to_markdown();
+        lfformat::console::stdout(format_args!("{table}"))?;
+        lfformat::note!("report written to {}", a.out.join("report.html").display());
     }
     Ok(())
 }

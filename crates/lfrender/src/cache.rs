@@ -886,7 +886,7 @@ mod tests {
         };
         let (plain, plain_edge) = fill(false);
         let (shrunk, shrunk_edge) = fill(true);
-        eprintln!(
+        lfformat::note!(
             "rms {plain:.4} → {shrunk:.4}, worst at the step {plain_edge:.3} → {shrunk_edge:.3}"
         );
         // 16 samples of variance 1/12: the plain cells' rms is about 0.072.

@@ -149,7 +149,7 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("lftrain: {e:#}");
+            lfformat::note!("lftrain: {e:#}");
             ExitCode::FAILURE
         }
     }
@@ -184,7 +184,7 @@ fn run(cli: Cli) -> Result<()> {
                 steps: t.steps,
             };
             let summary = train(cfg, &args)?;
-            eprintln!(
+            lfformat::note!(
                 "lftrain: {} steps logged, {:.3} s per step",
                 summary.records.len(),
                 summary.seconds_per_step
@@ -213,7 +213,7 @@ fn run(cli: Cli) -> Result<()> {
                     refresh: pool_refresh,
                 };
                 let (first, crops) = bench_loader(&cfg, &dataset, pool, batches)?;
-                println!(
+                lfformat::say!(
                     "loader ({} threads): batch {} of {}x{} crops: first batch after {first:.2} s, \
                      then {crops:.1} crops/s ({:.3} s per batch) over {batches} batches",
                     rayon::current_num_threads(),
@@ -221,11 +221,11 @@ fn run(cli: Cli) -> Result<()> {
                     cfg.patch,
                     cfg.patch,
                     cfg.batch as f64 / crops
-                );
+                )?;
                 return Ok(());
             }
             let (s, params) = bench_steps(&cfg, grid, steps)?;
-            println!(
+            lfformat::say!(
                 "{} ({params} parameter values incl. batch-norm statistics): batch {} of {}x{} patches, {grid}x{grid} views, \
                  on {:?}: {s:.3} s per step ({:.1} samples/s)",
                 cfg.model.name(),
@@ -234,7 +234,7 @@ fn run(cli: Cli) -> Result<()> {
                 cfg.patch,
                 lftrain::train::default_device(),
                 cfg.batch as f64 / s
-            );
+            )?;
         }
         Command::Predict {
             run,
@@ -252,7 +252,7 @@ fn run(cli: Cli) -> Result<()> {
                 mode_window,
             };
             let n = predict_dataset_over(&run, &dataset, &out, cli.quiet, &overrides)?;
-            eprintln!("lftrain: {n} scenes written to {}", out.display());
+            lfformat::note!("lftrain: {n} scenes written to {}", out.display());
         }
     }
     Ok(())

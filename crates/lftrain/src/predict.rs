@@ -430,7 +430,7 @@ pub fn predict_dataset_over(
     bar.finish_and_clear();
     let warning = output_range(&cfg).and_then(|reach| reach_warning(cfg.model, reach, &ranges));
     if let Some(w) = warning {
-        eprintln!("lftrain predict: {w}");
+        lfformat::note!("lftrain predict: {w}");
     }
     Ok(scenes.len())
 }

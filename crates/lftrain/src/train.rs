@@ -110,7 +110,7 @@ pub fn train(mut cfg: TrainConfig, args: &TrainArgs) -> Result<TrainSummary> {
     let base = default_device();
     if !args.quiet {
         // Names the backend: a wgpu build runs where BURN_DEVICE (or the first adapter) says.
-        eprintln!("lftrain: training on {base:?}");
+        lfformat::note!("lftrain: training on {base:?}");
     }
     let device = base.clone().autodiff();
     let (net, optim) = if args.resume {

@@ -67,11 +67,11 @@ pub fn fetch(out: &Path, nonfree: bool) -> Result<Summary> {
     for package in PACKAGES {
         let deb = match cached_deb(&cache, package)? {
             Some(deb) => {
-                eprintln!("{package}: reusing {}", deb.display());
+                lfformat::note!("{package}: reusing {}", deb.display());
                 deb
             }
             None => {
-                eprintln!("{package}: apt-get download …");
+                lfformat::note!("{package}: apt-get download …");
                 run_tool("apt-get", &["download".as_ref(), package.as_ref()], &cache)?;
                 cached_deb(&cache, package)?.with_context(|| {
                     format!("apt-get download {package} wrote no {package}_*.deb")
@@ -87,7 +87,7 @@ pub fn fetch(out: &Path, nonfree: bool) -> Result<Summary> {
     }
     fs::create_dir_all(&root)?;
     for deb in &debs {
-        eprintln!("dpkg-deb -x {}", deb.display());
+        lfformat::note!("dpkg-deb -x {}", deb.display());
         run_tool(
             "dpkg-deb",
             &["-x".as_ref(), deb.as_os_str(), root.as_os_str()],
