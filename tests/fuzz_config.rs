@@ -8,6 +8,7 @@
 //! address-space limit, where an abort or a hang would show as a signal or a time-out.
 
 mod mutate;
+mod skip;
 
 use lfgen::config::Config;
 use lfgen::pipeline::{RenderJob, generate_scene};
@@ -168,7 +169,7 @@ fn thousands_of_mutated_configs_are_refused_or_rendered_never_a_panic_or_a_hang(
 #[test]
 fn mutated_configs_through_the_binary_exit_0_or_1_within_bounds() {
     if !can_bound() {
-        eprintln!("skipped: prlimit (util-linux) is missing");
+        skip::skip("prlimit is missing (apt-get install util-linux; .ci/run installs it)");
         return;
     }
     let dir = tempfile::tempdir().unwrap();

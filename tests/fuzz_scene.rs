@@ -8,6 +8,7 @@
 
 mod bin;
 mod mutate;
+mod skip;
 
 use lfgen::config::Config;
 use lfgen::render::RenderScene;
@@ -140,7 +141,7 @@ fn thousands_of_mutated_scene_files_are_refused_or_rendered_never_a_panic() {
 #[test]
 fn mutated_scene_files_through_the_binary_exit_0_or_1_within_bounds() {
     if !can_bound() {
-        eprintln!("skipped: prlimit (util-linux) is missing");
+        skip::skip("prlimit is missing (apt-get install util-linux; .ci/run installs it)");
         return;
     }
     let dir = tempfile::tempdir().unwrap();

@@ -16,6 +16,7 @@
 
 mod bin;
 mod pov;
+mod skip;
 
 use glam::Vec3;
 use lfformat::pfm::read_pfm;

@@ -39,6 +39,7 @@
 
 mod bin;
 mod pov;
+mod skip;
 
 use lfformat::modes::{ModeMap, read_modes_exr};
 use lfgen::config::Config;

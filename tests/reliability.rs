@@ -4,6 +4,7 @@
 //! two runs or leaves unlisted scenes beside a new dataset.
 
 mod bin;
+mod skip;
 
 use bin::{TINY, files, generate, lfgen, ok, stderr};
 use lfformat::manifest::{Manifest, scene_entry_verifies};
@@ -82,14 +83,14 @@ fn render_never_replaces_a_folder_lfgen_did_not_write() {
     assert!(leftovers.is_empty(), "left behind: {leftovers:?}");
 }
 
-/// Runs `lfgen` under `strace`, every `write` to `victim` failing with ENOSPC; `None` (with the
-/// reason printed) where strace is missing or may not trace.
+/// Runs `lfgen` under `strace`, every `write` to `victim` failing with ENOSPC; `None` where
+/// strace is missing or may not trace (a skip; a failure under CI).
 fn with_full_disk_at(victim: &Path, args: &[&str]) -> Option<Output> {
     let probe = Command::new("strace")
         .args(["-qq", "-o", "/dev/null", "true"])
         .status();
     if !probe.is_ok_and(|s| s.success()) {
-        eprintln!("skipped: strace is missing or cannot trace here (.ci/run installs it)");
+        skip::skip("strace is missing or cannot trace here (.ci/run installs it)");
         return None;
     }
     let output = Command::new("strace")

@@ -3,9 +3,11 @@
 //! a small dataset, one task is killed mid-scene and requeued, the merge job runs after the
 //! array, and the result is byte-identical to one plain `lfgen` run.
 //!
-//! Skipped, with the reason printed, where the daemons are missing or cannot start (not root).
+//! Where the daemons are missing or cannot start (not root), the test prints why and skips;
+//! under CI, which installs them, that is a failure with the reason (`tests/skip`).
 
 mod bin;
+mod skip;
 
 use bin::{files, lfgen, ok};
 use std::net::TcpListener;
@@ -209,17 +211,13 @@ fn shard_0_writing(out: &Path) -> bool {
 #[test]
 fn slurm_array_with_a_requeued_task_and_a_merge_job_equals_one_plain_run() {
     if let Some(why) = unavailable() {
-        println!("skipped: {why}");
-        return;
+        return skip::skip(&why);
     }
     // A machine with the packages but without what the daemons need (a container without
     // root capabilities, say) skips too; once the cluster is up, every failure is the recipe's.
     let cluster = match Cluster::start() {
         Ok(c) => c,
-        Err(why) => {
-            println!("skipped: the SLURM cluster did not start: {why}");
-            return;
-        }
+        Err(why) => return skip::skip(&format!("the SLURM cluster did not start: {why}")),
     };
     let work = tempfile::tempdir().unwrap();
     let out = work.path().join("ds");
