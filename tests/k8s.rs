@@ -2,16 +2,29 @@
 //! Kubernetes API schemas (`kubernetes-validate --strict`, which `.ci/run` installs), a broken
 //! one does not, and the exact shell commands of the shard and merge Jobs — run here for each
 //! completion index, with only the binary, the folder and the dataset size swapped for small
-//! ones — give a dataset byte-identical to one plain run.
+//! ones — give a dataset byte-identical to one plain run. The fields that make the recipe
+//! work on a one-node cluster as shipped are checked by name, and `run.sh` is run against a
+//! scripted `kubectl`: it stops at a failed Job and merges only after every shard completed.
 //!
-//! Skipped, with the reason printed, where `kubernetes-validate` is missing.
+//! Where `kubernetes-validate` is missing the test prints why and skips; under CI, which
+//! installs it, that is a failure (`tests/skip`).
 
 mod bin;
+mod skip;
 
 use bin::{TINY, files, lfgen, ok};
 use serde_json::Value;
+use std::fs::Permissions;
+use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};
 use std::process::Command;
+
+const MANIFESTS: [&str; 4] = [
+    "volume.yaml",
+    "shards-job.yaml",
+    "merge-job.yaml",
+    "copy-pod.yaml",
+];
 
 fn recipe(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -60,17 +73,34 @@ fn shell_command(job: &Value) -> String {
     }
 }
 
-#[test]
-fn k8s_manifests_validate_and_their_commands_give_the_plain_dataset() {
-    if Command::new("kubernetes-validate")
+/// Whether `kubernetes-validate` (and the PyYAML it brings, which [`manifest`] uses) is
+/// here; if not, the test skips, or fails under CI.
+fn validator() -> bool {
+    let found = Command::new("kubernetes-validate")
         .arg("--version")
         .output()
-        .is_err()
-    {
-        println!("skipped: kubernetes-validate is missing (pip install kubernetes-validate)");
+        .is_ok();
+    if !found {
+        skip::skip("kubernetes-validate is missing (pip install kubernetes-validate)");
+    }
+    found
+}
+
+/// The pod template's first container of a Job, or the container of a Pod.
+fn container(manifest: &Value) -> &Value {
+    let pod = match manifest["kind"].as_str() {
+        Some("Pod") => manifest,
+        _ => &manifest["spec"]["template"],
+    };
+    &pod["spec"]["containers"][0]
+}
+
+#[test]
+fn k8s_manifests_validate_and_their_commands_give_the_plain_dataset() {
+    if !validator() {
         return;
     }
-    for name in ["volume.yaml", "shards-job.yaml", "merge-job.yaml"] {
+    for name in MANIFESTS {
         let (passed, text) = validate(&recipe(name));
         assert!(passed, "{name}: {text}");
     }
@@ -130,5 +160,122 @@ fn k8s_manifests_validate_and_their_commands_give_the_plain_dataset() {
     assert!(
         sharded == files(&plain),
         "the Kubernetes recipe's dataset differs from one plain run"
+    );
+}
+
+/// The causes of a recipe that did not work as shipped: an image that was always pulled (so a
+/// locally built one was never used), a claim that needed ReadWriteMany and named no class, and
+/// a shard that failed for good leaving the Job running.
+#[test]
+fn k8s_manifests_run_a_local_image_on_a_one_node_cluster_and_fail_fast() {
+    if !validator() {
+        return;
+    }
+    for name in ["shards-job.yaml", "merge-job.yaml", "copy-pod.yaml"] {
+        let c = container(&manifest(name)).clone();
+        assert_eq!(c["image"], "lfgen:latest", "{name}");
+        assert_eq!(c["imagePullPolicy"], "IfNotPresent", "{name}");
+        assert_eq!(
+            c["volumeMounts"][0]["mountPath"], "/data",
+            "{name} mounts the dataset volume"
+        );
+    }
+    let volume = manifest("volume.yaml");
+    assert_eq!(volume["metadata"]["name"], "lfgen-data");
+    assert_eq!(volume["spec"]["storageClassName"], "local-path");
+    assert_eq!(
+        volume["spec"]["accessModes"],
+        serde_json::json!(["ReadWriteOnce"])
+    );
+    let shards = manifest("shards-job.yaml");
+    assert_eq!(shards["spec"]["backoffLimitPerIndex"], 3);
+    assert_eq!(
+        shards["spec"]["maxFailedIndexes"], 0,
+        "one shard that fails for good must fail the Job"
+    );
+    assert!(shards["spec"]["activeDeadlineSeconds"].as_u64().is_some());
+    // One pod fits a laptop: its CPU request is the threads it runs.
+    let c = container(&shards);
+    assert_eq!(c["resources"]["requests"]["cpu"], "4");
+    assert!(shell_command(&shards).contains("--threads 4"));
+    assert_eq!(manifest("merge-job.yaml")["spec"]["backoffLimit"], 2);
+}
+
+/// Runs `deploy/k8s/run.sh` against a scripted `kubectl` that logs its arguments, has no claim
+/// yet and answers `get job/NAME` with the lines of `NAME` in `states`, one per look (the last
+/// one repeated): the script's exit status, its stderr and the log.
+fn run_sh(states: &[(&str, &[&str])]) -> (Option<i32>, String, String) {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    for (job, lines) in states {
+        std::fs::write(dir.join(job), lines.join("\n") + "\n").unwrap();
+    }
+    let kubectl = dir.join("kubectl");
+    std::fs::write(
+        &kubectl,
+        r#"#!/bin/sh
+echo "$*" >> "$FAKE/log"
+case "$1 $2" in
+"get pvc") exit 1 ;;
+"get job/"*)
+    f="$FAKE/${2#job/}"
+    head -n 1 "$f"
+    [ "$(wc -l < "$f")" -gt 1 ] && sed -i 1d "$f"
+    ;;
+esac
+exit 0
+"#,
+    )
+    .unwrap();
+    std::fs::set_permissions(&kubectl, Permissions::from_mode(0o755)).unwrap();
+    let o = Command::new(recipe("run.sh"))
+        .env("FAKE", dir)
+        .env("KUBECTL", &kubectl)
+        .env("LFGEN_POLL", "0")
+        .output()
+        .unwrap();
+    let log = std::fs::read_to_string(dir.join("log")).unwrap();
+    (o.status.code(), bin::stderr(&o), log)
+}
+
+#[test]
+fn k8s_run_sh_stops_at_a_failed_shard_job() {
+    let (code, err, log) = run_sh(&[(
+        "lfgen-shards",
+        &["", "FailureTarget", "FailureTarget Failed"],
+    )]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("run.sh: job/lfgen-shards failed"), "{err}");
+    assert_eq!(log.matches("get job/lfgen-shards").count(), 3, "{log}");
+    assert!(
+        !log.contains("merge-job.yaml"),
+        "merged after a failed shard: {log}"
+    );
+}
+
+#[test]
+fn k8s_run_sh_merges_once_every_shard_completed() {
+    let (code, err, log) = run_sh(&[
+        ("lfgen-shards", &["", "SuccessCriteriaMet Complete"]),
+        ("lfgen-merge", &["Complete"]),
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    let steps: Vec<&str> = log
+        .lines()
+        .map(|l| l.split(" -o ").next().unwrap())
+        .collect();
+    let apply = |name: &str| format!("apply -f {}", recipe(name).display());
+    assert_eq!(
+        steps,
+        [
+            "get pvc lfgen-data".to_string(),
+            apply("volume.yaml"),
+            "delete job lfgen-shards lfgen-merge --ignore-not-found --cascade=foreground".into(),
+            apply("shards-job.yaml"),
+            "get job/lfgen-shards".into(),
+            "get job/lfgen-shards".into(),
+            apply("merge-job.yaml"),
+            "get job/lfgen-merge".into(),
+        ]
     );
 }
