@@ -1,5 +1,5 @@
 //! Renders of scenes whose images and depth ground truth are known in closed form, checked
-//! against formulas (docs/conventions.md, Camera; Slices and modes) rather than against the renderer's own output.
+//! against formulas (docs/reference/format.md, Camera; Slices and modes) rather than against the renderer's own output.
 
 mod common;
 

@@ -286,7 +286,7 @@ mod tests {
     }
 
     /// A point on the focus plane keeps its pixel in every view; others move by the view
-    /// offset times their disparity (docs/conventions.md, Camera).
+    /// offset times their disparity (docs/reference/format.md, Camera).
     #[test]
     fn focus_plane_stays_in_register() {
         let mut cam = camera();

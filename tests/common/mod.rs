@@ -52,13 +52,13 @@ pub const CACHE: CacheParams = CacheParams {
     final_gather: false,
 };
 
-/// Focal length in pixels, from docs/conventions.md, Camera (not from the code under test).
+/// Focal length in pixels, from docs/reference/format.md, Camera (not from the code under test).
 pub fn f_px(cam: &LightFieldCamera) -> f64 {
     let max_side = cam.resolution[0].max(cam.resolution[1]) as f64;
     cam.focal_length_mm * max_side / cam.sensor_size_mm
 }
 
-/// Disparity of planar depth `z`, from docs/conventions.md, Camera.
+/// Disparity of planar depth `z`, from docs/reference/format.md, Camera.
 pub fn disparity(cam: &LightFieldCamera, z: f64) -> f64 {
     f_px(cam) * cam.baseline_m * (1.0 / z - 1.0 / cam.focus_distance_m)
 }

@@ -1,5 +1,5 @@
 //! Framing a scene: measure the depth range the camera grid sees, then fit baseline, focus and
-//! the slice partition to it (docs/conventions.md, Camera; Slices and modes).
+//! the slice partition to it (docs/reference/format.md, Camera; Slices and modes).
 
 use super::RenderScene;
 use crate::camera::LightFieldCamera;

@@ -1,5 +1,5 @@
 //! Single-pass multimodal ground truth: per-sample hits → 128 depth slices → over-compositing
-//! → modes (docs/conventions.md, Slices and modes; thesis eq. 5.17–5.19).
+//! → modes (docs/reference/format.md, Slices and modes; thesis eq. 5.17–5.19).
 //!
 //! Per sample, the hits of one slice composite front to back with the over operator, giving
 //! that slice's coverage α and α-weighted depth; per pixel these are averaged over samples (box

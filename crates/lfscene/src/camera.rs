@@ -2,7 +2,7 @@
 //!
 //! World space is right-handed, metres, +Y up (glTF). Every view shares the centre camera's
 //! orientation; view `(u, v)` sits `(u-uc)·b` along `right` and `(vc-v)·b` along `up` (row 0 is
-//! the top row), and its sensor is shifted so the focus plane stays in register (docs/conventions.md, Camera).
+//! the top row), and its sensor is shifted so the focus plane stays in register (docs/reference/format.md, Camera).
 //! Ray directions have a forward component of exactly 1, so a hit's `t` *is* its planar depth.
 
 use anyhow::{Result, ensure};
@@ -110,7 +110,7 @@ impl LightFieldCamera {
         1.0 / (d / (self.f_px() * self.baseline_m) + 1.0 / self.focus_distance_m)
     }
 
-    /// Sets baseline and focus so `[z_near, z_far]` maps onto `[d_min, d_max]` (docs/conventions.md, Camera).
+    /// Sets baseline and focus so `[z_near, z_far]` maps onto `[d_min, d_max]` (docs/reference/format.md, Camera).
     pub fn fit_disparity_range(&mut self, z_near: f64, z_far: f64, [d_min, d_max]: [f64; 2]) {
         let f = self.f_px();
         self.baseline_m = (d_max - d_min) / (f * (1.0 / z_near - 1.0 / z_far));

@@ -1,7 +1,7 @@
 //! The four view stacks through the centre view (EPINET's input, thesis appendix B.1) and the
 //! EPI shift that refocuses them (thesis eq. 4.2 / 5.11).
 //!
-//! EPINET's order for 9×9 (docs/conventions.md): 0° = views 36..44 left→right, 90° = 76, 67, …, 4
+//! EPINET's order for 9×9 (docs/reference/format.md): 0° = views 36..44 left→right, 90° = 76, 67, …, 4
 //! bottom→top, 45° = 72, 64, …, 8 (bottom-left → top-right), −45° = 0, 10, …, 80. Along every
 //! stack the view offset grows "forward" in the same sense, so that a quarter turn maps the 90°
 //! stack onto a 0° stack and the 45° stack onto a −45° one (the network shares their weights).
