@@ -155,7 +155,7 @@ pub struct LoadedCatalog {
 impl LoadedCatalog {
     /// Reads and parses `path`; the entries are not checked (see [`Asset::problem`]).
     pub fn read(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let text = crate::read::text(path)?;
         let catalog: Catalog = serde_json::from_str(&text)
             .map_err(|e| Error::format(path, format!("not a valid asset catalogue: {e}")))?;
         if catalog.version != VERSION {

@@ -2,7 +2,6 @@
 //! with its checksum, so that resumed or sharded runs can tell finished scenes from broken ones.
 
 use std::collections::BTreeMap;
-use std::fs::File;
 use std::io::Read;
 use std::path::Path;
 
@@ -57,7 +56,7 @@ pub struct Manifest {
 impl Manifest {
     /// Reads and parses `path`.
     pub fn read(path: &Path) -> Result<Self> {
-        let text = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        let text = crate::read::bytes(path)?;
         serde_json::from_slice(&text).map_err(|e| Error::format(path, e.to_string()))
     }
 
@@ -71,11 +70,17 @@ impl Manifest {
     }
 }
 
-/// Lowercase hex SHA-256 and size of the file at `path`, read in chunks so that large
-/// files are not held in memory.
+/// Lowercase hex SHA-256 and size of the regular file at `path` ([`crate::read::open`]),
+/// read in chunks so that large files are not held in memory.
 pub fn sha256_file(path: &Path) -> Result<(String, u64)> {
+    sha256_at_most(path, u64::MAX)
+}
+
+/// [`sha256_file`] reading at most `limit` bytes: a file that turns out longer reports
+/// `limit` bytes, which the caller compares with the size it expected.
+fn sha256_at_most(path: &Path, limit: u64) -> Result<(String, u64)> {
     let io = |e| Error::io(path, e);
-    let mut file = File::open(path).map_err(io)?;
+    let mut file = crate::read::open(path)?.take(limit);
     let mut hasher = Sha256::new();
     let mut buffer = vec![0u8; 1 << 16];
     let mut bytes = 0u64;
@@ -88,6 +93,12 @@ pub fn sha256_file(path: &Path) -> Result<(String, u64)> {
         bytes += n as u64;
     }
     Ok((hex(&hasher.finalize()), bytes))
+}
+
+/// SHA-256 and size of the file a manifest entry describes, reading at most one byte more
+/// than it records: a file grown without bound cannot keep the check reading.
+fn sha256_of_entry(path: &Path, f: &FileEntry) -> Result<(String, u64)> {
+    sha256_at_most(path, f.bytes.saturating_add(1))
 }
 
 /// Lowercase hex SHA-256 of `bytes` (content keys of assets, textures and configs).
@@ -110,7 +121,17 @@ pub fn verify_scene_entry(root: &Path, e: &SceneEntry) -> Result<()> {
     }
     for f in &e.files {
         let path = root.join(&f.path);
-        let (hex, bytes) = sha256_file(&path)?;
+        let (hex, bytes) = sha256_of_entry(&path, f)?;
+        if bytes > f.bytes {
+            return Err(Error::format(
+                &path,
+                format!(
+                    "does not match manifest.json (more than the {} bytes it records): damaged \
+                     or changed since it was generated",
+                    f.bytes
+                ),
+            ));
+        }
         if bytes != f.bytes || !hex.eq_ignore_ascii_case(&f.sha256) {
             return Err(Error::format(
                 &path,
@@ -136,6 +157,7 @@ pub fn scene_entry_verifies(root: &Path, e: &SceneEntry) -> bool {
             let path = root.join(&f.path);
             let size_matches = std::fs::metadata(&path).is_ok_and(|m| m.len() == f.bytes);
             size_matches
-                && sha256_file(&path).is_ok_and(|(hex, _)| hex.eq_ignore_ascii_case(&f.sha256))
+                && sha256_of_entry(&path, f)
+                    .is_ok_and(|(hex, _)| hex.eq_ignore_ascii_case(&f.sha256))
         })
 }

@@ -227,7 +227,7 @@ pub fn read_modes_exr(path: &Path) -> Result<ModeMap> {
         .all_channels()
         .first_valid_layer()
         .all_attributes()
-        .from_file(path)
+        .from_unbuffered(crate::read::open(path)?)
         .map_err(|e| exr_error(path, e))?;
     let layer = image.layer_data;
     let (width, height) = (layer.size.width(), layer.size.height());

@@ -129,7 +129,8 @@ pub fn write_mpi_npz(path: &Path, mpi: &Mpi) -> Result<()> {
 /// Reads the `mpi` array of an npz written by [`write_mpi_npz`] (or by numpy), top-down.
 pub fn read_mpi_npz(path: &Path) -> Result<Mpi> {
     let npz_err = |e| npz_error(path, e);
-    let mut npz = NpzArchive::open(path).map_err(npz_err)?;
+    let file = BufReader::new(crate::read::open(path)?);
+    let mut npz = NpzArchive::new(file).map_err(npz_err)?;
     let file = match npz.zip_archive().by_name(&file_name_from_array_name(KEY)) {
         Ok(file) => file,
         Err(ZipError::FileNotFound) => {

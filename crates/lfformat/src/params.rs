@@ -116,9 +116,7 @@ impl HciParameters {
 
     /// Reads and parses the file at `path`.
     pub fn read(path: &Path) -> Result<Self> {
-        let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-        let text = String::from_utf8(bytes).map_err(|_| Error::format(path, "not UTF-8 text"))?;
-        Self::parse_ini(&text, path)
+        Self::parse_ini(&crate::read::text(path)?, path)
     }
 
     /// Writes [`HciParameters::to_ini`] to `path`.

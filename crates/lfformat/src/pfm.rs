@@ -103,8 +103,7 @@ pub fn write_pfm(path: &Path, img: &FloatImage) -> Result<()> {
 
 /// Reads a single-channel PFM from `path`, top-down.
 pub fn read_pfm(path: &Path) -> Result<FloatImage> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    decode_pfm(&bytes, path)
+    decode_pfm(&crate::read::bytes(path)?, path)
 }
 
 /// What the header says about the pixel block that follows it.

@@ -1,6 +1,7 @@
 //! The views of a scene folder (`input_CamNNN.png`) as RGB in `[0, 1]`: the reader that
 //! evaluation baselines and training share.
 
+use std::io::BufReader;
 use std::path::Path;
 
 use serde::Serialize;
@@ -121,7 +122,11 @@ pub fn centre_view(dir: &Path) -> Result<(Vec<f32>, usize, usize)> {
 
 /// An 8-bit (or 16-bit) image as RGB in `[0, 1]`, checked against the expected size.
 pub fn read_rgb(path: &Path, width: usize, height: usize) -> Result<Vec<f32>> {
-    let img = image::open(path)
+    let file = BufReader::new(crate::read::open(path)?);
+    let img = image::ImageReader::new(file)
+        .with_guessed_format()
+        .map_err(|e| Error::io(path, e))?
+        .decode()
         .map_err(|e| Error::format(path, format!("cannot read image: {e}")))?
         .into_rgb32f();
     if (img.width() as usize, img.height() as usize) != (width, height) {
