@@ -13,6 +13,7 @@ pub use crate::render::slices::SliceAssignment;
 pub use crate::scene::SliceSpacing;
 pub use crate::scene::gltf::GltfSettings as GltfConfig;
 use crate::scene::gltf::ImportSettings;
+use crate::scene::memory::{self, Budget};
 use crate::scene::{MAX_GRID, MAX_SLICES};
 use crate::scene::{SceneStart, SliceRange};
 use anyhow::{Context, Result, bail};
@@ -375,6 +376,8 @@ impl Config {
         if c.resolution.iter().any(|&n| n == 0 || n > 16384) {
             bail!("camera.resolution out of range: {:?}", c.resolution);
         }
+        let views = format!("camera.resolution {:?} (grid {:?})", c.resolution, c.grid);
+        Budget::of_this_process()?.charge(&views, memory::view_bytes(c.resolution, c.grid))?;
         if c.disparity_range[0] >= c.disparity_range[1]
             || c.disparity_range.iter().any(|d| !d.is_finite())
         {

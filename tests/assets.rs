@@ -14,7 +14,7 @@ use lfgen::procgen::library::AssetLibrary;
 use lfgen::scene::assets::Assets;
 use lfgen::scene::obj::ObjFile;
 use lfgen::scene::shapes::tessellate;
-use lfgen::scene::texture_image::srgb_to_linear;
+use lfgen::scene::texture_image::{DecodeBudgets, srgb_to_linear};
 use lfgen::scene::{Opacity, Shape, Texture};
 use std::path::{Path, PathBuf};
 
@@ -84,7 +84,8 @@ fn mtl_colour_dissolve_and_maps_become_materials() {
         panic!("map_d is an image opacity");
     };
     assert_eq!(*factor, 1.0);
-    let alpha = leaf.texture_image(image.image).unwrap();
+    let budgets = DecodeBudgets::for_images_alone().unwrap();
+    let alpha = leaf.texture_image(image.image, &budgets).unwrap();
     let at = |u: f32| alpha.sample(image, Vec2::new(u, 0.5)).w;
     assert_eq!((at(0.1), at(0.9)), (1.0, 0.0));
 }

@@ -3,11 +3,12 @@
 //! and shared by every object and material that uses them.
 
 use super::gltf::GltfFile;
+use super::memory::{self, Budget};
 use super::obj::ObjFile;
 use super::shapes::MeshTri;
-use super::texture_image::{ImageMap, TextureImage};
+use super::texture_image::{DecodeBudgets, ImageMap, TextureImage};
 use super::{Material, Opacity, SceneDesc, Shape, SourceFile, Texture};
-use anyhow::{Context, Result, ensure};
+use anyhow::{Context, Result};
 use std::collections::BTreeMap;
 use std::collections::btree_map::Entry;
 use std::sync::Arc;
@@ -73,9 +74,11 @@ impl Assets {
         Self::from_files_within(desc, files, MAX_IMAGE_BYTES)
     }
 
-    /// [`Assets::from_files`] with at most `image_budget` decoded texel bytes. Images that are
-    /// the same data (glTF images naming one file or one buffer view) are decoded once and
-    /// count once.
+    /// [`Assets::from_files`] with at most `image_budget` decoded texel bytes. Every
+    /// instance's triangles are counted from the files, and every image's size read from its
+    /// header, against the scene's [`memory::scene_budget`] before anything is loaded or
+    /// decoded. Images that are the same data (glTF images naming one file or one buffer
+    /// view) are decoded once and count once.
     pub fn from_files_within(
         desc: &SceneDesc,
         files: &[Source],
@@ -86,6 +89,21 @@ impl Assets {
                 .get(source as usize)
                 .with_context(|| format!("the scene refers to missing source file {source}"))
         };
+        // "image 2 of /models/chair.obj": the source's path, where the description has it.
+        let of = |what: String, source: u32| match desc.sources.get(source as usize) {
+            Some(s) => format!("{what} of {}", s.path),
+            None => what,
+        };
+        let mut memory = memory::scene_budget(desc)?;
+        for o in &desc.objects {
+            if let Some(key) = MeshKey::of(&o.shape) {
+                let what = of(
+                    format!("object {:?}: mesh {}", o.name, key.mesh),
+                    key.source,
+                );
+                memory.charge_triangles(&what, file(key.source)?.triangle_count(key)?)?;
+            }
+        }
         let mut assets = Self::default();
         for key in desc.objects.iter().filter_map(|o| MeshKey::of(&o.shape)) {
             if let Entry::Vacant(slot) = assets.meshes.entry(key) {
@@ -93,6 +111,10 @@ impl Assets {
                 slot.insert(file.primitive_triangles(key)?);
             }
         }
+        let mut budgets = DecodeBudgets {
+            textures: Budget::textures(image_budget),
+            memory,
+        };
         let mut decoded: BTreeMap<(u32, String), Arc<TextureImage>> = BTreeMap::new();
         for map in desc.materials.iter().flat_map(image_maps) {
             if let Entry::Vacant(slot) = assets.images.entry((map.source, map.image)) {
@@ -101,19 +123,12 @@ impl Assets {
                 let image = match decoded.entry(same) {
                     Entry::Occupied(e) => e.get().clone(),
                     Entry::Vacant(e) => {
-                        let image = Arc::new(src.texture_image(map.image)?);
+                        let what = of(format!("image {}", map.image), map.source);
+                        let image = (src.texture_image(map.image, &budgets))
+                            .with_context(|| what.clone())?;
+                        budgets.charge(&what, &image)?;
                         assets.image_bytes += image.texel_bytes();
-                        ensure!(
-                            assets.image_bytes <= image_budget,
-                            "the scene's images take over {} MiB decoded (image {} of {}): \
-                             use fewer or smaller textures",
-                            image_budget >> 20,
-                            map.image,
-                            desc.sources
-                                .get(map.source as usize)
-                                .map_or("?", |s| s.path.as_str())
-                        );
-                        e.insert(image).clone()
+                        e.insert(Arc::new(image)).clone()
                     }
                 };
                 slot.insert(image);
@@ -180,10 +195,18 @@ impl Source {
         }
     }
 
-    fn texture_image(&self, image: u32) -> Result<TextureImage> {
+    fn texture_image(&self, image: u32, budgets: &DecodeBudgets) -> Result<TextureImage> {
         match self {
-            Source::Gltf(f) => f.texture_image(image),
-            Source::Obj(f) => f.texture_image(image),
+            Source::Gltf(f) => f.texture_image(image, budgets),
+            Source::Obj(f) => f.texture_image(image, budgets),
+        }
+    }
+
+    /// Triangles of a mesh as its file declares them, before they are read.
+    fn triangle_count(&self, key: MeshKey) -> Result<u64> {
+        match self {
+            Source::Gltf(f) => f.primitive_triangle_count(key.mesh, key.primitive),
+            Source::Obj(f) => f.mesh_triangle_count(key.mesh),
         }
     }
 

@@ -12,6 +12,7 @@ pub mod files;
 pub mod gltf;
 pub mod light;
 pub mod material;
+pub mod memory;
 pub mod obj;
 pub mod shapes;
 pub mod texture_image;

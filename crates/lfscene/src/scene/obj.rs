@@ -5,12 +5,14 @@
 //!
 //! Reading is as defensive as the glTF reader: bounded file sizes, material libraries and
 //! textures only from inside the model's `root` folder, face indices checked (by `tobj`),
-//! non-finite coordinates, missing libraries and missing textures refused with an error that
-//! names the problem.
+//! non-finite coordinates, material values that make no material (`Kd nan`), missing libraries
+//! and missing textures refused with an error that names the problem. Faces that mix vertices
+//! with and without `vt` or `vn` are valid OBJ and are read (see [`drop_partial_attributes`]).
 
 use super::files::{read_limited, resolve_inside};
 use super::shapes::MeshTri;
-use super::texture_image::{Filter, ImageMap, TextureImage, Wrap, srgb_to_linear};
+use super::texture_image::{DecodeBudgets, Filter, ImageMap, TextureImage, Wrap, srgb_to_linear};
+use super::validate::check_material;
 use super::{Material, Opacity, Resource, SourceFile, SurfaceModel, Texture};
 use anyhow::{Context, Result, bail, ensure};
 use glam::{Mat3, Vec2, Vec3};
@@ -20,7 +22,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// Most triangles one file may have.
-const MAX_TRIANGLES: usize = 4 << 20;
+const MAX_TRIANGLES: u64 = 4 << 20;
 
 /// A texture a material uses, and whether as colour or as opacity (`map_d`).
 #[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -66,6 +68,11 @@ impl ObjFile {
             .parent()
             .context("the file has no folder")?
             .to_path_buf();
+        let triangles = face_triangles(&bytes);
+        ensure!(
+            triangles <= MAX_TRIANGLES,
+            "{triangles} triangles, more than the {MAX_TRIANGLES} lfgen reads from one model"
+        );
         let read_log = RefCell::new(BTreeMap::new());
         let problem = RefCell::new(None);
         let loader = |mtl: &Path| match load_mtl(&dir, &root, mtl, &read_log) {
@@ -85,9 +92,13 @@ impl ObjFile {
         if let Some(e) = problem.into_inner() {
             return Err(e);
         }
-        let (models, materials) = parsed.map_err(|e| anyhow::anyhow!("not a readable OBJ: {e}"))?;
+        let (mut models, materials) =
+            parsed.map_err(|e| anyhow::anyhow!("not a readable OBJ: {e}"))?;
         let materials = materials.map_err(|e| anyhow::anyhow!("material library: {e}"))?;
         check_models(&models, materials.len())?;
+        for m in &mut models {
+            drop_partial_attributes(&mut m.mesh);
+        }
         let mut file = Self {
             path,
             root,
@@ -99,6 +110,7 @@ impl ObjFile {
             read_log,
         };
         file.index_textures(&dir)?;
+        file.check_materials()?;
         Ok(file)
     }
 
@@ -158,6 +170,13 @@ impl ObjFile {
     /// Number of meshes (object / material groups).
     pub fn mesh_count(&self) -> usize {
         self.models.len()
+    }
+
+    /// Triangles of mesh `mesh` (faces are triangulated when the file is read).
+    pub fn mesh_triangle_count(&self, mesh: u32) -> Result<u64> {
+        let m = (self.models.get(mesh as usize))
+            .with_context(|| format!("mesh {mesh} does not exist"))?;
+        Ok(m.mesh.indices.len() as u64 / 3)
     }
 
     /// Material of mesh `mesh`: an index into [`Self::materials`], or `None` for the default.
@@ -235,9 +254,9 @@ impl ObjFile {
         }
     }
 
-    /// Decodes image `index`; an opacity map without an alpha channel gives its grey level as
-    /// alpha (`map_d` is a scalar texture).
-    pub fn texture_image(&self, index: u32) -> Result<TextureImage> {
+    /// Decodes image `index` within `budgets` (charged by the caller); an opacity map without
+    /// an alpha channel gives its grey level as alpha (`map_d` is a scalar texture).
+    pub fn texture_image(&self, index: u32, budgets: &DecodeBudgets) -> Result<TextureImage> {
         let t = self
             .textures
             .get(index as usize)
@@ -249,17 +268,31 @@ impl ObjFile {
         self.read_log
             .borrow_mut()
             .insert(t.rel.clone(), hex_sha256(&bytes));
-        let image = TextureImage::decode(&bytes, &what)?;
+        let image = TextureImage::decode(&bytes, &what, budgets)?;
         Ok(match t.alpha && image.is_opaque() {
             true => image.grey_as_alpha(),
             false => image,
         })
     }
 
-    /// Decodes every texture once (a library check: a corrupt image fails here, not while a
-    /// scene renders).
+    /// Refuses a material whose MTL values make no lfgen material (`Kd nan`), with the scene
+    /// check's message: caught here, a catalogue entry is skipped instead of failing a scene.
+    fn check_materials(&self) -> Result<()> {
+        for m in self.materials(0) {
+            check_material(&m).with_context(|| format!("material {:?}", m.name))?;
+        }
+        Ok(())
+    }
+
+    /// Decodes every texture once (a library check: a corrupt image, or textures that alone
+    /// do not fit the budgets of a scene, fail here, not while a scene renders).
     pub fn check_textures(&self) -> Result<()> {
-        (0..self.textures.len() as u32).try_for_each(|i| self.texture_image(i).map(drop))
+        let mut budgets = DecodeBudgets::for_images_alone()?;
+        for (i, t) in self.textures.iter().enumerate() {
+            let image = self.texture_image(i as u32, &budgets)?;
+            budgets.charge(&format!("texture {:?}", t.rel), &image)?;
+        }
+        Ok(())
     }
 
     /// Finds every texture the materials use (relative to the OBJ's folder), refusing missing
@@ -331,7 +364,35 @@ fn map_file(statement: &str) -> &str {
     }
 }
 
-/// Refuses what would make the renderer misbehave: too many triangles, non-finite
+/// `tobj` gives a vertex a normal (texture coordinate) only where its face names one, so a
+/// mesh whose faces mix `f 1/1/1 …` with `f 1 2 3` has fewer normals than vertices and no
+/// record of which vertex they belong to: such a mesh is read without that attribute — face
+/// normals, UV (0, 0) — as a mesh whose file has none.
+fn drop_partial_attributes(mesh: &mut tobj::Mesh) {
+    let vertices = mesh.positions.len() / 3;
+    if mesh.normals.len() != 3 * vertices {
+        mesh.normals.clear();
+    }
+    if mesh.texcoords.len() != 2 * vertices {
+        mesh.texcoords.clear();
+    }
+}
+
+/// Triangles the face lines (`f …`) of an OBJ make, an n-gon counting n − 2: known before
+/// `tobj` builds them, so an oversized model is refused before it takes memory.
+fn face_triangles(bytes: &[u8]) -> u64 {
+    bytes
+        .split(|&b| b == b'\n')
+        .filter_map(|line| {
+            let rest = line.trim_ascii_start().strip_prefix(b"f")?;
+            rest.first().filter(|b| b.is_ascii_whitespace())?;
+            let corners = (rest.split(u8::is_ascii_whitespace)).filter(|w| !w.is_empty());
+            Some(corners.count().saturating_sub(2) as u64)
+        })
+        .sum()
+}
+
+/// Refuses what would make the renderer misbehave: non-finite
 /// coordinates, dangling material ids, no geometry at all (`tobj` already refuses face indices
 /// out of bounds).
 fn check_models(models: &[tobj::Model], materials: usize) -> Result<()> {
@@ -358,10 +419,6 @@ fn check_models(models: &[tobj::Model], materials: usize) -> Result<()> {
             ensure!(id < materials, "{}: material {id} does not exist", what());
         }
     }
-    ensure!(
-        triangles <= MAX_TRIANGLES,
-        "{triangles} triangles, more than the {MAX_TRIANGLES} lfgen reads from one model"
-    );
     if triangles == 0 {
         bail!("no faces");
     }

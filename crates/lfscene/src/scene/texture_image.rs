@@ -5,15 +5,16 @@
 //! Texels stay 8-bit (4 bytes each, a quarter of linear floats) and are linearised through a
 //! lookup table when sampled; bilinear filtering then happens on linear values, as it must.
 
-use anyhow::{Context, Result, bail};
+use super::assets::MAX_IMAGE_BYTES;
+use super::memory::{self, Budget};
+use anyhow::{Context, Result, bail, ensure};
 use glam::{Vec2, Vec3, Vec4};
+use image::ImageDecoder;
 use serde::{Deserialize, Serialize};
 use std::sync::LazyLock;
 
 /// Largest accepted image side, in texels.
 pub const MAX_IMAGE_SIDE: u32 = 16384;
-/// Largest allocation the decoder may make for one image.
-const MAX_DECODE_BYTES: u64 = 1 << 30;
 
 /// Where a material's texture comes from and how it is sampled.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -66,6 +67,31 @@ impl UvTransform {
     }
 }
 
+/// What decoded images may take: texel bytes of their own, and memory with the rest of the
+/// scene.
+#[derive(Clone, Debug)]
+pub struct DecodeBudgets {
+    pub textures: Budget,
+    pub memory: Budget,
+}
+
+impl DecodeBudgets {
+    /// Budgets for the images of one scene with nothing else charged: [`MAX_IMAGE_BYTES`] of
+    /// texels within this process's [`memory::limit`].
+    pub fn for_images_alone() -> Result<Self> {
+        Ok(Self {
+            textures: Budget::textures(MAX_IMAGE_BYTES),
+            memory: Budget::of_this_process()?,
+        })
+    }
+
+    /// Counts a decoded image's texels against both budgets.
+    pub fn charge(&mut self, what: &str, image: &TextureImage) -> Result<()> {
+        self.textures.charge(what, image.texel_bytes())?;
+        self.memory.charge(what, image.texel_bytes())
+    }
+}
+
 /// A decoded image: RGBA8 texels, row 0 at the top (glTF's UV origin is the top-left corner).
 #[derive(Clone)]
 pub struct TextureImage {
@@ -100,8 +126,12 @@ impl std::fmt::Debug for TextureImage {
 }
 
 impl TextureImage {
-    /// Decodes PNG or JPEG bytes (the formats of core glTF). `what` names the image in errors.
-    pub fn decode(bytes: &[u8], what: &str) -> Result<Self> {
+    /// Decodes PNG or JPEG bytes (the formats of core glTF), refusing from the image header —
+    /// before anything is allocated — an image whose texels or decoding peak do not fit what
+    /// is left of `budgets`; [`DecodeBudgets::charge`] then counts the texels. `what` names
+    /// the image in errors.
+    pub fn decode(bytes: &[u8], what: &str, budgets: &DecodeBudgets) -> Result<Self> {
+        let DecodeBudgets { textures, memory } = budgets;
         let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
             .with_guessed_format()
             .with_context(|| format!("{what}: cannot read"))?;
@@ -109,15 +139,26 @@ impl TextureImage {
             Some(image::ImageFormat::Png | image::ImageFormat::Jpeg) => {}
             other => bail!("{what}: only PNG and JPEG images are read (found {other:?})"),
         }
-        let mut limits = image::Limits::default();
-        limits.max_image_width = Some(MAX_IMAGE_SIDE);
-        limits.max_image_height = Some(MAX_IMAGE_SIDE);
-        limits.max_alloc = Some(MAX_DECODE_BYTES);
-        reader.limits(limits);
-        let rgba = reader
-            .decode()
+        reader.limits(decode_limits(memory.left()));
+        let mut decoder = reader
+            .into_decoder()
+            .with_context(|| format!("{what}: cannot decode"))?;
+        let (width, height) = decoder.dimensions();
+        ensure!(
+            width.max(height) <= MAX_IMAGE_SIDE,
+            "{what}: {width}×{height} texels, more than {MAX_IMAGE_SIDE} a side"
+        );
+        let sized = format!("{what} ({width}×{height} texels)");
+        let pixel = decoder.color_type().bytes_per_pixel() as u64;
+        textures.fits(&sized, width as u64 * height as u64 * 4)?;
+        let peak = memory::texture_decode_bytes(width, height, pixel);
+        memory.fits(&format!("decoding {sized}"), peak)?;
+        decoder
+            .set_limits(decode_limits(peak))
+            .with_context(|| format!("{what}: cannot decode"))?;
+        let rgba = image::DynamicImage::from_decoder(decoder)
             .with_context(|| format!("{what}: cannot decode"))?
-            .to_rgba8();
+            .into_rgba8();
         let (width, height) = rgba.dimensions();
         let texels: Vec<[u8; 4]> = rgba.pixels().map(|p| p.0).collect();
         Ok(Self::from_texels(width, height, texels))
@@ -216,6 +257,16 @@ impl TextureImage {
     }
 }
 
+/// What the `image` crate may allocate: at most `max_alloc` bytes, sides of at most
+/// [`MAX_IMAGE_SIDE`].
+fn decode_limits(max_alloc: u64) -> image::Limits {
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(MAX_IMAGE_SIDE);
+    limits.max_image_height = Some(MAX_IMAGE_SIDE);
+    limits.max_alloc = Some(max_alloc);
+    limits
+}
+
 /// Integer texel coordinate `i` (any float, also non-finite) wrapped into `0..n`.
 #[inline]
 fn wrap(i: f32, n: u32, mode: Wrap) -> u32 {
@@ -308,16 +359,20 @@ mod tests {
         assert!((uv - Vec2::new(1.0, 0.0)).length() < 1e-6, "{uv}");
     }
 
+    fn budgets() -> DecodeBudgets {
+        DecodeBudgets::for_images_alone().unwrap()
+    }
+
     #[test]
     fn decode_rejects_other_formats_and_reads_png() {
-        let err = TextureImage::decode(b"GIF89a....", "image 0").unwrap_err();
+        let err = TextureImage::decode(b"GIF89a....", "image 0", &budgets()).unwrap_err();
         assert!(format!("{err:#}").contains("image 0"), "{err:#}");
         let mut png = Vec::new();
         image::RgbaImage::from_raw(2, 1, vec![0, 0, 0, 255, 255, 255, 255, 51])
             .unwrap()
             .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
             .unwrap();
-        let img = TextureImage::decode(&png, "image 0").unwrap();
+        let img = TextureImage::decode(&png, "image 0", &budgets()).unwrap();
         assert_eq!((img.width, img.height), (2, 1));
         assert_eq!(img.texels, two_texels().texels);
         // JPEG (lossy, opaque): a flat grey survives within a code or two.
@@ -328,7 +383,7 @@ mod tests {
                 image::ImageFormat::Jpeg,
             )
             .unwrap();
-        let img = TextureImage::decode(&jpeg, "image 1").unwrap();
+        let img = TextureImage::decode(&jpeg, "image 1", &budgets()).unwrap();
         assert!(img.is_opaque() && img.texels.iter().all(|t| t[0].abs_diff(128) <= 2));
         assert_eq!(format!("{img:?}"), "TextureImage(8x8, opaque: true)");
     }

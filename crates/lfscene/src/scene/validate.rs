@@ -5,12 +5,15 @@
 //! field and the value, so the error points at the line to fix, and the bounds keep a bad
 //! number from allocating gigabytes or looping for hours.
 
-use super::{MAX_GRID, MAX_SLICES, MAX_TRIANGLES};
+use super::memory;
+use super::{MAX_GRID, MAX_SLICES};
 use super::{Material, Object, Opacity, SceneDesc, Shape, SliceRange, SurfaceModel, Texture};
 use crate::camera::LightFieldCamera;
 use anyhow::{Context, Result, bail, ensure};
 use std::path::Path;
 
+/// Longest scene name, in bytes (a file name's limit on common filesystems).
+const MAX_NAME_BYTES: usize = 255;
 /// Largest image side (as `camera.resolution` of the config).
 const MAX_RESOLUTION: u32 = 16384;
 /// Finest tessellation of a parametric shape along one direction.
@@ -32,8 +35,10 @@ impl SceneDesc {
         Ok(desc)
     }
 
-    /// Checks every field the renderer relies on; the error names the field.
+    /// Checks every field the renderer relies on, the error naming the field, and that what
+    /// the description sizes itself (views, parametric shapes) fits the memory limit.
     pub fn validate(&self) -> Result<()> {
+        check_name(&self.name)?;
         check_camera(&self.camera)?;
         check_slices(&self.slices)?;
         ensure!(
@@ -49,23 +54,34 @@ impl SceneDesc {
         for (i, m) in self.materials.iter().enumerate() {
             check_material(m).map_err(|e| e.context(format!("materials[{i}] ({:?})", m.name)))?;
         }
-        let mut triangles = 0u64;
         for (i, o) in self.objects.iter().enumerate() {
-            triangles += check_object(o, self.materials.len(), self.sources.len())
+            check_object(o, self.materials.len(), self.sources.len())
                 .map_err(|e| e.context(format!("objects[{i}] ({:?})", o.name)))?;
         }
-        ensure!(
-            triangles <= MAX_TRIANGLES as u64,
-            "the shapes tessellate into {triangles} triangles, more than {MAX_TRIANGLES}"
-        );
         for (i, l) in self.lights.iter().enumerate() {
             ensure!(
                 l.is_valid(),
                 "lights[{i}]: numbers must be finite, colours non-negative, directions unit"
             );
         }
-        Ok(())
+        memory::scene_budget(self).map(drop)
     }
+}
+
+/// The name goes into `parameters.cfg` and file listings: one short line.
+fn check_name(name: &str) -> Result<()> {
+    ensure!(
+        !name.is_empty() && name.len() <= MAX_NAME_BYTES,
+        "name must be 1 to {MAX_NAME_BYTES} bytes, not {}",
+        name.len()
+    );
+    ensure!(
+        !name
+            .chars()
+            .any(|c| c.is_control() || c == '/' || c == '\\'),
+        "name {name:?} must not hold control characters or path separators"
+    );
+    Ok(())
 }
 
 fn check_camera(c: &LightFieldCamera) -> Result<()> {
@@ -133,7 +149,8 @@ fn check_slices(s: &SliceRange) -> Result<()> {
     Ok(())
 }
 
-fn check_material(m: &Material) -> Result<()> {
+/// Checks one material's values (also of a model's materials when its file is opened).
+pub(super) fn check_material(m: &Material) -> Result<()> {
     ensure!(
         unit_interval(m.roughness) && unit_interval(m.metallic),
         "roughness {} and metallic {} must be in [0, 1]",
@@ -179,8 +196,8 @@ fn check_material(m: &Material) -> Result<()> {
     Ok(())
 }
 
-/// Checks one object and returns an upper bound of its triangle count.
-fn check_object(o: &Object, materials: usize, sources: usize) -> Result<u64> {
+/// Checks one object (its triangles are counted by [`memory::scene_budget`]).
+fn check_object(o: &Object, materials: usize, sources: usize) -> Result<()> {
     ensure!(
         (o.material as usize) < materials,
         "material {} does not exist ({materials} materials)",
@@ -211,17 +228,15 @@ fn check_object(o: &Object, materials: usize, sources: usize) -> Result<u64> {
             n <= MAX_SEGMENTS,
             "segments/rings {n} is more than {MAX_SEGMENTS}"
         );
-        Ok(n.max(3) as u64)
+        Ok(())
     };
     let size = |v: &[f32]| v.iter().all(|&x| (0.0..=MAX_EXTENT).contains(&x));
-    let triangles = match &o.shape {
+    match &o.shape {
         Shape::Cuboid { size: s } | Shape::Room { size: s } => {
             ensure!(size(&s.to_array()), "size {s} must be 0 to {MAX_EXTENT}");
-            12
         }
         Shape::Quad { size: s } => {
             ensure!(size(s), "size {s:?} must be 0 to {MAX_EXTENT}");
-            2
         }
         Shape::Wall { size: s, holes } => {
             ensure!(size(s), "size {s:?} must be 0 to {MAX_EXTENT}");
@@ -229,7 +244,6 @@ fn check_object(o: &Object, materials: usize, sources: usize) -> Result<u64> {
                 within(holes.iter().flatten()) && holes.len() <= 1024,
                 "holes must be within {MAX_EXTENT} and at most 1024"
             );
-            2 + 8 * holes.len() as u64
         }
         Shape::Sphere {
             radius,
@@ -240,7 +254,8 @@ fn check_object(o: &Object, materials: usize, sources: usize) -> Result<u64> {
                 size(&[*radius]),
                 "radius {radius} must be 0 to {MAX_EXTENT}"
             );
-            2 * segments(*rings)? * segments(*n)?
+            segments(*rings)?;
+            segments(*n)?;
         }
         Shape::Cylinder {
             radius,
@@ -251,7 +266,7 @@ fn check_object(o: &Object, materials: usize, sources: usize) -> Result<u64> {
                 size(&[*radius, *height]),
                 "radius {radius} and height {height} must be 0 to {MAX_EXTENT}"
             );
-            4 * segments(*n)?
+            segments(*n)?;
         }
         Shape::Lathe {
             profile,
@@ -261,7 +276,7 @@ fn check_object(o: &Object, materials: usize, sources: usize) -> Result<u64> {
                 within(profile.iter().flatten()) && profile.len() <= 65536,
                 "profile must be within {MAX_EXTENT} and at most 65536 points"
             );
-            2 * profile.len() as u64 * segments(*n)?
+            segments(*n)?;
         }
         Shape::Mesh { source, matrix, .. } => {
             ensure!(
@@ -269,10 +284,9 @@ fn check_object(o: &Object, materials: usize, sources: usize) -> Result<u64> {
                 "source {source} does not exist ({sources} sources)"
             );
             ensure!(within(matrix), "matrix entries must be within {MAX_EXTENT}");
-            0 // counted when the mesh is read (`MAX_TRIANGLES` there)
         }
-    };
-    Ok(triangles)
+    }
+    Ok(())
 }
 
 /// Whether every value is within ±[`MAX_EXTENT`] (NaN is not).

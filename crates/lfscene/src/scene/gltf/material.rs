@@ -3,7 +3,7 @@
 
 use super::Notes;
 use super::source::GltfFile;
-use crate::scene::texture_image::{Filter, ImageMap, UvTransform, Wrap};
+use crate::scene::texture_image::{DecodeBudgets, Filter, ImageMap, UvTransform, Wrap};
 use crate::scene::{Material, Opacity, SurfaceModel, Texture};
 use ::gltf::material::AlphaMode;
 use ::gltf::texture::{self, MagFilter, WrappingMode};
@@ -114,7 +114,8 @@ fn emission(file: &GltfFile, m: &::gltf::Material) -> Result<Vec3> {
         return Ok(factor);
     };
     let image = info.texture().source().index() as u32;
-    let texture = file.texture_image(image).context("emissiveTexture")?;
+    let budgets = DecodeBudgets::for_images_alone()?;
+    let texture = (file.texture_image(image, &budgets)).context("emissiveTexture")?;
     Ok(factor * texture.mean_linear_rgb())
 }
 

@@ -17,19 +17,7 @@ impl GltfFile {
         primitive: u32,
         uv_set: u32,
     ) -> Result<Vec<MeshTri>> {
-        let m = self
-            .doc
-            .meshes()
-            .nth(mesh as usize)
-            .with_context(|| format!("mesh {mesh} does not exist"))?;
-        let p = m
-            .primitives()
-            .nth(primitive as usize)
-            .with_context(|| format!("mesh {mesh} has no primitive {primitive}"))?;
-        let of = match m.name() {
-            Some(name) => format!("mesh {mesh} {name:?} primitive {primitive}"),
-            None => format!("mesh {mesh} primitive {primitive}"),
-        };
+        let (p, of) = self.primitive(mesh, primitive)?;
         check_mode(p.mode(), &of)?;
         let pos_acc = p
             .get(&Semantic::Positions)
@@ -58,6 +46,35 @@ impl GltfFile {
                 triangle(idx, &positions, normals.as_deref(), uvs.as_deref())
             })
             .collect())
+    }
+
+    /// Triangles of one primitive as its accessors declare them (indices, else vertices, over
+    /// three): known before any of its data is read, so memory can be checked first.
+    pub fn primitive_triangle_count(&self, mesh: u32, primitive: u32) -> Result<u64> {
+        let (p, of) = self.primitive(mesh, primitive)?;
+        let count = match (p.indices(), p.get(&Semantic::Positions)) {
+            (Some(acc), _) | (None, Some(acc)) => acc.count(),
+            (None, None) => bail!("{of} has no POSITION"),
+        };
+        Ok(count as u64 / 3)
+    }
+
+    /// Primitive `primitive` of mesh `mesh`, with its description for errors.
+    fn primitive(&self, mesh: u32, primitive: u32) -> Result<(::gltf::Primitive<'_>, String)> {
+        let m = self
+            .doc
+            .meshes()
+            .nth(mesh as usize)
+            .with_context(|| format!("mesh {mesh} does not exist"))?;
+        let p = m
+            .primitives()
+            .nth(primitive as usize)
+            .with_context(|| format!("mesh {mesh} has no primitive {primitive}"))?;
+        let of = match m.name() {
+            Some(name) => format!("mesh {mesh} {name:?} primitive {primitive}"),
+            None => format!("mesh {mesh} primitive {primitive}"),
+        };
+        Ok((p, of))
     }
 
     /// An optional per-vertex attribute, which must have one element per vertex.

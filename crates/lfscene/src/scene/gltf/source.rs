@@ -3,7 +3,7 @@
 //! name a file beside the glTF (or below its folder) or be a base64 `data:` URI of bounded size.
 
 use crate::scene::files::{read_limited, resolve_inside};
-use crate::scene::texture_image::TextureImage;
+use crate::scene::texture_image::{DecodeBudgets, TextureImage};
 use crate::scene::{Resource, SourceFile};
 use ::gltf::buffer::View;
 use anyhow::{Context, Result, anyhow, bail, ensure};
@@ -175,8 +175,9 @@ impl GltfFile {
             .with_context(|| format!("image {index} does not exist"))
     }
 
-    /// Decodes image `index` (PNG or JPEG, from a buffer view, a file or a data URI).
-    pub fn texture_image(&self, index: u32) -> Result<TextureImage> {
+    /// Decodes image `index` (PNG or JPEG, from a buffer view, a file or a data URI) within
+    /// `budgets` (charged by the caller).
+    pub fn texture_image(&self, index: u32, budgets: &DecodeBudgets) -> Result<TextureImage> {
         let image = self.image(index)?;
         let what = match image.name() {
             Some(name) => format!("image {index} ({name:?})"),
@@ -188,7 +189,7 @@ impl GltfFile {
             }
             ::gltf::image::Source::Uri { uri, .. } => Cow::Owned(self.read_uri(uri, &what)?),
         };
-        TextureImage::decode(&bytes, &what)
+        TextureImage::decode(&bytes, &what, budgets)
     }
 
     /// What image `index` decodes: its buffer view, or the file or data URI it names (two
