@@ -31,9 +31,10 @@ pub const PIXEL_BYTES: u64 = 768;
 pub const VIEW_PIXEL_BYTES: u64 = 32;
 
 /// Bytes per triangle while a scene renders: the mesh-space copy, the world-space triangle
-/// with its material and object, and its share of the BVH (measured: 375 with a sphere of
-/// 2 M triangles).
-pub const TRIANGLE_BYTES: u64 = 400;
+/// with its material and object, and its share of the BVH (measured: 375 resident with a
+/// sphere of 2 M triangles; about twice that in address space, where growing vectors reserve
+/// double, so a 7.5 M-triangle sphere at 400 failed under a 4 GiB `prlimit --as`).
+pub const TRIANGLE_BYTES: u64 = 768;
 
 /// The limit: [`LIMIT_VAR`] if set, else [`DEFAULT_SHARE`] of the smaller of the machine's
 /// memory and the address-space limit (`ulimit -v`, `prlimit --as`); with neither known, no
