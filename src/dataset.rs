@@ -19,7 +19,7 @@ use crate::stats::{DatasetSummary, SceneStats};
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use lfformat::lock::Lock;
-use lfformat::manifest::{Manifest, SceneEntry, scene_entry_verifies};
+use lfformat::manifest::{Manifest, SceneEntry, scene_entry_verifies, verify_scene_entry};
 use std::collections::BTreeMap;
 use std::fs;
 use std::io::Write;
@@ -40,19 +40,23 @@ pub struct GenerateOptions {
     pub strict: bool,
 }
 
-/// Split of scene `index` (see `dataset.val_every`).
-pub fn split_of(cfg: &Config, index: u64) -> &'static str {
+/// Split of scene `index` of a dataset of `scenes` scenes (see `dataset.val_every`): every
+/// `val_every`-th scene goes to `val`, and a dataset too small to hold one such scene still
+/// gets a `val` split: its last scene (none when it has a single scene). The rule depends on
+/// the total count alone, so every shard of a dataset agrees on it.
+pub fn split_of(cfg: &Config, index: u64, scenes: u64) -> &'static str {
     let every = cfg.dataset.val_every;
-    if every > 0 && index % every == every - 1 {
-        "val"
-    } else {
-        "train"
-    }
+    let val = match every {
+        0 => false,
+        _ if scenes < every => scenes >= 2 && index == scenes - 1,
+        _ => index % every == every - 1,
+    };
+    if val { "val" } else { "train" }
 }
 
-/// Folder of scene `index`, relative to the dataset root.
-pub fn scene_dir(cfg: &Config, index: u64) -> String {
-    format!("{}/scene_{index:04}", split_of(cfg, index))
+/// Folder of scene `index` of a dataset of `scenes` scenes, relative to the dataset root.
+pub fn scene_dir(cfg: &Config, index: u64, scenes: u64) -> String {
+    format!("{}/scene_{index:04}", split_of(cfg, index, scenes))
 }
 
 fn manifest_name((i, n): (u64, u64)) -> String {
@@ -65,14 +69,17 @@ fn manifest_name((i, n): (u64, u64)) -> String {
 
 /// Generates the dataset (or this shard of it).
 pub fn generate(cfg: &Config, opts: &GenerateOptions) -> Result<()> {
+    check_dataset_or_empty(&opts.out)?;
     let _locks = lock_dataset(&opts.out, opts.shard)?;
     let manifest_path = opts.out.join(manifest_name(opts.shard));
     let mut manifest = open_manifest(cfg, opts, &manifest_path)?;
+    let shard_scenes = check_other_manifests(opts, &manifest.config_hash)?;
     check_unlisted_scenes(cfg, opts)?;
     if opts.shard.1 > 1 {
         check_one_layout(&opts.out, opts.shard.1)?;
         // Written at once so that a shard of another layout starting now sees this one.
         let fresh = !manifest_path.exists();
+        mark_dataset(&opts.out)?;
         manifest.write(&manifest_path)?;
         if let Err(e) = check_one_layout(&opts.out, opts.shard.1) {
             if fresh {
@@ -91,15 +98,19 @@ pub fn generate(cfg: &Config, opts: &GenerateOptions) -> Result<()> {
     let per_scene = w as u64 * h as u64 * job.samples_per_pixel(views);
     let bar = progress_bar(todo.len() as u64 * per_scene, opts.quiet);
     let samples = AtomicU64::new(0);
-    let (mut done, mut skipped) = (0, 0);
+    let (mut done, mut skipped, mut unsaved) = (0, 0, false);
     for index in todo {
-        let dir = scene_dir(cfg, index);
-        if opts.resume
-            && manifest
-                .scenes
-                .iter()
-                .any(|e| e.index == index && scene_entry_verifies(&opts.out, e))
-        {
+        let dir = scene_dir(cfg, index, opts.scenes);
+        let kept = opts.resume.then(|| {
+            let candidates = manifest.scenes.iter().chain(&shard_scenes);
+            candidates
+                .filter(|e| e.index == index)
+                .find(|e| scene_entry_verifies(&opts.out, e))
+                .cloned()
+        });
+        if let Some(entry) = kept.flatten() {
+            unsaved |= !manifest.scenes.contains(&entry);
+            record(&mut manifest, entry);
             skipped += 1;
             samples.fetch_add(per_scene, Ordering::Relaxed);
             continue;
@@ -107,6 +118,7 @@ pub fn generate(cfg: &Config, opts: &GenerateOptions) -> Result<()> {
         let started = Instant::now();
         let (mut desc, scene) = generate_scene(cfg, index, library.as_ref())
             .with_context(|| format!("scene {index}"))?;
+        mark_dataset(&opts.out)?;
         let before = samples.load(Ordering::Relaxed);
         let files = std::thread::scope(|s| {
             let ticker = s.spawn(|| tick(&bar, &samples, before + per_scene));
@@ -123,16 +135,18 @@ pub fn generate(cfg: &Config, opts: &GenerateOptions) -> Result<()> {
             r
         })
         .with_context(|| format!("scene {index} ({dir})"))?;
-        manifest.scenes.retain(|e| e.index != index);
-        manifest.scenes.push(SceneEntry {
-            index,
-            split: split_of(cfg, index).into(),
-            dir: dir.clone(),
-            files,
-        });
-        manifest.scenes.sort_by_key(|e| e.index);
-        manifest.splits = count_splits(&manifest.scenes);
+        let split = split_of(cfg, index, opts.scenes).into();
+        record(
+            &mut manifest,
+            SceneEntry {
+                index,
+                split,
+                dir,
+                files,
+            },
+        );
         manifest.write(&manifest_path)?;
+        unsaved = false;
         log_timing(&opts.out, index, started.elapsed().as_secs_f64(), per_scene)?;
         done += 1;
         bar.set_message(format!("{done} scenes rendered, {skipped} verified"));
@@ -140,10 +154,21 @@ pub fn generate(cfg: &Config, opts: &GenerateOptions) -> Result<()> {
     bar.finish_with_message(format!(
         "{done} scenes rendered, {skipped} verified and kept"
     ));
+    if unsaved {
+        manifest.write(&manifest_path)?;
+    }
     if opts.shard.1 == 1 {
         write_readme(&opts.out, &manifest)?;
     }
     Ok(())
+}
+
+/// Puts `entry` into `manifest` in place of any entry of its scene.
+fn record(manifest: &mut Manifest, entry: SceneEntry) {
+    manifest.scenes.retain(|e| e.index != entry.index);
+    manifest.scenes.push(entry);
+    manifest.scenes.sort_by_key(|e| e.index);
+    manifest.splits = count_splits(&manifest.scenes);
 }
 
 /// The asset library of `scene.catalog`, checked once; each skipped entry is reported on one
@@ -258,6 +283,114 @@ fn lock_dataset(out: &Path, (i, n): (u64, u64)) -> Result<Vec<Lock>> {
     Ok(vec![shard, shared])
 }
 
+/// The file that marks a folder as an lfgen dataset, written before the first file of the
+/// dataset: runs write into a folder only if it is new, empty, marked or holds a manifest, so
+/// a folder of the user's (their `README.md`, `summary.json`, …) is never written into.
+const DATASET_MARKER: &str = ".lfgen-dataset";
+
+/// Fails, before anything is created or written, if `out` is an existing folder that holds
+/// files but is no lfgen dataset (no [`DATASET_MARKER`], no manifest). The lock files of a run
+/// killed before it wrote anything do not count.
+fn check_dataset_or_empty(out: &Path) -> Result<()> {
+    if !out.is_dir() {
+        return Ok(());
+    }
+    let mut foreign = Vec::new();
+    for entry in fs::read_dir(out).with_context(|| format!("cannot list {}", out.display()))? {
+        let name = entry?.file_name().to_string_lossy().into_owned();
+        let lock =
+            name == DATASET_LOCK || (name.starts_with(".lfgen.shard-") && name.ends_with(".lock"));
+        if name == DATASET_MARKER || name == "manifest.json" || shard_count(&name).is_some() {
+            return Ok(());
+        }
+        if !lock {
+            foreign.push(name);
+        }
+    }
+    foreign.sort();
+    let Some(first) = foreign.first() else {
+        return Ok(());
+    };
+    bail!(
+        "--out {} is not an lfgen dataset and not empty (it holds {first:?}{}): lfgen writes a \
+         dataset only into a new or empty folder, or one it made; choose another --out",
+        out.display(),
+        if foreign.len() > 1 { ", …" } else { "" }
+    )
+}
+
+/// Writes [`DATASET_MARKER`] into `out` unless it is there. Created in place, never under a
+/// temporary name that a concurrent run would take for a foreign file; its presence is all
+/// that counts, so a write cut short still marks the folder.
+fn mark_dataset(out: &Path) -> Result<()> {
+    let path = out.join(DATASET_MARKER);
+    let text = b"This folder is an lfgen dataset (see manifest.json and README.md).\n";
+    let created = fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&path);
+    match created {
+        Ok(mut file) => file.write_all(text),
+        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => Ok(()),
+        Err(e) => Err(e),
+    }
+    .with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Checks the other manifests of `out` against this run, and returns the scenes of shard
+/// manifests that an unsharded `--resume` may keep. Every manifest must be of this config and
+/// seed: a run of another would overwrite their scenes. An unsharded run without `--resume`
+/// also refuses shards that were not merged: their scenes are a dataset of their own.
+fn check_other_manifests(opts: &GenerateOptions, config_hash: &str) -> Result<Vec<SceneEntry>> {
+    let own = manifest_name(opts.shard);
+    let mut others = Vec::new();
+    for name in manifest_names(&opts.out)? {
+        if name != own {
+            others.push((Manifest::read(&opts.out.join(&name))?, name));
+        }
+    }
+    let unsharded = opts.shard.1 == 1;
+    if unsharded && !opts.resume {
+        refuse_unmerged_shards(&opts.out, &others)?;
+    }
+    if let Some((m, name)) = others.iter().find(|(m, _)| m.config_hash != config_hash) {
+        bail!(
+            "{}: a dataset of another config or seed (seed {}, {} scene(s)) is in this folder, \
+             and this run would overwrite its scenes: run with its config and seed to complete \
+             it, or choose another --out",
+            opts.out.join(name).display(),
+            m.seed,
+            m.scenes.len()
+        );
+    }
+    Ok(match unsharded {
+        true => others.into_iter().flat_map(|(m, _)| m.scenes).collect(),
+        false => Vec::new(),
+    })
+}
+
+/// Fails if any of `manifests` (those beside an unsharded run's own) lists scenes.
+fn refuse_unmerged_shards(out: &Path, manifests: &[(Manifest, String)]) -> Result<()> {
+    let listing: Vec<&(Manifest, String)> = manifests
+        .iter()
+        .filter(|(m, _)| !m.scenes.is_empty())
+        .collect();
+    let Some((first, _)) = listing.first() else {
+        return Ok(());
+    };
+    let names: Vec<&str> = listing.iter().map(|(_, n)| n.as_str()).collect();
+    let scenes: usize = listing.iter().map(|(m, _)| m.scenes.len()).sum();
+    bail!(
+        "{} holds {scenes} scene(s) of a sharded run that was not merged ({}; seed {}): run \
+         `lfgen merge {}` to join them into one dataset, pass --resume with their config and \
+         seed to complete the dataset from them, or choose another --out",
+        out.display(),
+        names.join(", "),
+        first.seed,
+        out.display()
+    )
+}
+
 /// The dataset-wide lock file (see the module docs).
 const DATASET_LOCK: &str = ".lfgen.lock";
 
@@ -268,12 +401,7 @@ const LOCK_HELP: &str = "another lfgen run is writing this dataset (an unsharded
 /// indices overlap this run's.
 fn check_one_layout(out: &Path, n: u64) -> Result<()> {
     for name in manifest_names(out)? {
-        let other = name
-            .strip_prefix("manifest.shard-")
-            .and_then(|r| r.strip_suffix(".json"))
-            .and_then(|r| r.split_once("-of-"))
-            .and_then(|(_, m)| m.parse::<u64>().ok());
-        if let Some(m) = other.filter(|&m| m != n) {
+        if let Some(m) = shard_count(&name).filter(|&m| m != n) {
             bail!(
                 "{} holds {name} of a {m}-way split; this run is {n}-way: shards of one dataset \
                  must use one N",
@@ -282,6 +410,14 @@ fn check_one_layout(out: &Path, n: u64) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// `N` of a shard manifest's name `manifest.shard-I-of-N.json`.
+fn shard_count(name: &str) -> Option<u64> {
+    name.strip_prefix("manifest.shard-")
+        .and_then(|r| r.strip_suffix(".json"))
+        .and_then(|r| r.split_once("-of-"))
+        .and_then(|(_, m)| m.parse().ok())
 }
 
 /// `manifest.json` and `manifest.shard-*.json` in `out`, sorted.
@@ -335,7 +471,7 @@ fn check_unlisted_scenes(cfg: &Config, opts: &GenerateOptions) -> Result<()> {
     let stray: Vec<String> = scene_folders(&opts.out)?
         .into_iter()
         .filter(|(dir, index)| {
-            let foreign = *index >= opts.scenes || *dir != scene_dir(cfg, *index);
+            let foreign = *index >= opts.scenes || *dir != scene_dir(cfg, *index, opts.scenes);
             let mine = index % opts.shard.1 == opts.shard.0;
             !listed.contains(dir) && (foreign || (mine && !opts.resume))
         })
@@ -360,54 +496,106 @@ fn check_unlisted_scenes(cfg: &Config, opts: &GenerateOptions) -> Result<()> {
 
 /// Render timings live outside the scene folders so those stay byte-reproducible.
 fn log_timing(out: &Path, index: u64, seconds: f64, samples: u64) -> Result<()> {
-    let path = out.join("timings.jsonl");
     let line = serde_json::json!({ "scene": index, "seconds": seconds, "camera_rays_per_second": samples as f64 / seconds });
-    let mut f = fs::OpenOptions::new()
-        .create(true)
-        .append(true)
-        .open(&path)
-        .with_context(|| format!("cannot write {}", path.display()))?;
-    writeln!(f, "{line}").with_context(|| format!("cannot write {}", path.display()))
+    Ok(lfformat::files::append_line(
+        &out.join("timings.jsonl"),
+        &line.to_string(),
+    )?)
 }
 
-/// Unions `manifest.json` and every `manifest.shard-*.json` of `out` into `manifest.json`,
-/// keeping only scenes whose files verify.
+/// Unions `manifest.json` and every `manifest.shard-*.json` of `out` into `manifest.json`.
+/// Every shard of the split must have run and every listed scene must verify: a missing shard
+/// or a damaged scene fails the merge, naming each, and writes nothing, so a merge job never
+/// reports success on a smaller dataset.
 pub fn merge(out: &Path) -> Result<Manifest> {
     if !out.is_dir() {
         bail!("{}: no such dataset folder", out.display());
     }
     let _lock = Lock::exclusive(&out.join(DATASET_LOCK)).context(LOCK_HELP)?;
+    let names = manifest_names(out)?;
+    check_every_shard_ran(out, &names)?;
     let mut parts = Vec::new();
-    for name in manifest_names(out)? {
-        parts.push(Manifest::read(&out.join(&name))?);
+    for name in &names {
+        parts.push(Manifest::read(&out.join(name))?);
     }
     let mut merged = parts
         .first()
         .cloned()
         .with_context(|| format!("{}: no manifest to merge", out.display()))?;
-    let mut scenes = BTreeMap::new();
-    for p in &parts {
-        if p.config_hash != merged.config_hash {
-            bail!(
-                "{}: shards were generated with different configs",
-                out.display()
-            );
-        }
-        for e in &p.scenes {
-            if scene_entry_verifies(out, e) {
-                scenes.insert(e.index, e.clone());
-            }
-        }
+    if parts.iter().any(|p| p.config_hash != merged.config_hash) {
+        bail!(
+            "{}: shards were generated with different configs",
+            out.display()
+        );
     }
-    merged.scenes = scenes.into_values().collect();
+    merged.scenes = verified_scenes(out, parts.into_iter().flat_map(|p| p.scenes))?;
     merged.splits = count_splits(&merged.scenes);
     merged.write(&out.join("manifest.json"))?;
     write_readme(out, &merged)?;
     Ok(merged)
 }
 
+/// Fails if `names` hold shard manifests of an `N`-way split but not all `N` of them: a shard
+/// that never ran (each writes its manifest as it starts) would leave its scenes out.
+fn check_every_shard_ran(out: &Path, names: &[String]) -> Result<()> {
+    let Some(n) = names.iter().find_map(|name| shard_count(name)) else {
+        return Ok(());
+    };
+    let missing: Vec<String> = (0..n)
+        .map(|i| manifest_name((i, n)))
+        .filter(|name| !names.contains(name))
+        .collect();
+    if let Some(first) = missing.first() {
+        bail!(
+            "{} has no {first}{}: {} of the {n} shards never ran; run them (--shard I/{n}, with \
+             --resume), then merge",
+            out.display(),
+            if missing.len() > 1 { " and others" } else { "" },
+            missing.len()
+        );
+    }
+    Ok(())
+}
+
+/// One entry per scene index among `entries`, each verified against its files; fails naming
+/// every scene of which no entry verifies, and why.
+fn verified_scenes(
+    out: &Path,
+    entries: impl Iterator<Item = SceneEntry>,
+) -> Result<Vec<SceneEntry>> {
+    let mut good = BTreeMap::new();
+    let mut damaged = BTreeMap::new();
+    for e in entries {
+        if good.contains_key(&e.index) {
+            continue;
+        }
+        match verify_scene_entry(out, &e) {
+            Ok(()) => {
+                damaged.remove(&e.index);
+                good.insert(e.index, e);
+            }
+            Err(why) => {
+                damaged.insert(e.index, format!("scene {} ({}): {why}", e.index, e.dir));
+            }
+        }
+    }
+    if !damaged.is_empty() {
+        let list: Vec<String> = damaged.into_values().collect();
+        bail!(
+            "{}: {} scene(s) do not verify, so nothing was merged:\n  {}\nrender them again \
+             with their shard's command and --resume (it redoes scenes that do not verify), \
+             then merge",
+            out.display(),
+            list.len(),
+            list.join("\n  ")
+        );
+    }
+    Ok(good.into_values().collect())
+}
+
 /// A short human-readable description at the dataset root.
 fn write_readme(out: &Path, m: &Manifest) -> Result<()> {
+    mark_dataset(out)?;
     let splits: Vec<String> = m.splits.iter().map(|(k, v)| format!("{v} {k}")).collect();
     let text = format!(
         "# lfgen dataset\n\nGenerated by {} {} with seed {} (config hash `{}`).\n\n\
@@ -449,4 +637,34 @@ fn write_summary(out: &Path, dirs: &[String]) -> Result<()> {
         &out.join("summary.json"),
         text.as_bytes(),
     )?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn val_scenes(cfg: &Config, scenes: u64) -> Vec<u64> {
+        (0..scenes)
+            .filter(|&i| split_of(cfg, i, scenes) == "val")
+            .collect()
+    }
+
+    /// Every dataset of two or more scenes has a val split; from `val_every` scenes on it is
+    /// the fixed every-11th rule, so full-size datasets keep their split.
+    #[test]
+    fn small_datasets_put_their_last_scene_in_val_and_large_ones_every_eleventh() {
+        let mut cfg = Config::default();
+        assert_eq!(val_scenes(&cfg, 1), Vec::<u64>::new());
+        assert_eq!(val_scenes(&cfg, 2), [1]);
+        assert_eq!(val_scenes(&cfg, 4), [3]);
+        assert_eq!(val_scenes(&cfg, 10), [9]);
+        assert_eq!(val_scenes(&cfg, 11), [10]);
+        assert_eq!(val_scenes(&cfg, 21), [10]);
+        assert_eq!(
+            val_scenes(&cfg, 110),
+            (0..10).map(|k| 11 * k + 10).collect::<Vec<_>>()
+        );
+        cfg.dataset.val_every = 0;
+        assert_eq!(val_scenes(&cfg, 4), Vec::<u64>::new());
+    }
 }

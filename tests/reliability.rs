@@ -86,6 +86,12 @@ fn render_never_replaces_a_folder_lfgen_did_not_write() {
 /// Runs `lfgen` under `strace`, every `write` to `victim` failing with ENOSPC; `None` where
 /// strace is missing or may not trace (a skip; a failure under CI).
 fn with_full_disk_at(victim: &Path, args: &[&str]) -> Option<Output> {
+    with_failing_writes(victim, "inject=write:error=ENOSPC", args)
+}
+
+/// [`with_full_disk_at`] with the writes that fail chosen by `inject`, strace's injection
+/// expression (`:when=2` fails the second write to `victim` only).
+fn with_failing_writes(victim: &Path, inject: &str, args: &[&str]) -> Option<Output> {
     let probe = Command::new("strace")
         .args(["-qq", "-o", "/dev/null", "true"])
         .status();
@@ -95,7 +101,7 @@ fn with_full_disk_at(victim: &Path, args: &[&str]) -> Option<Output> {
     }
     let output = Command::new("strace")
         .args(["-f", "-qq", "-o", "/dev/null", "-e", "trace=write"])
-        .args(["-e", "inject=write:error=ENOSPC", "-P"])
+        .args(["-e", inject, "-P"])
         .arg(victim)
         .arg(env!("CARGO_BIN_EXE_lfgen"))
         .args(args)
@@ -233,9 +239,10 @@ fn a_deleted_manifest_never_leaves_unlisted_scenes_beside_a_new_dataset() {
     failed_with(&r, "no manifest lists");
     failed_with(&r, "--resume");
     assert!(files(&out) == before, "a refused run changed the folder");
-    // Fewer scenes than the folder holds: the extra ones would be left beside the manifest.
+    // Fewer scenes than the folder holds: the extra ones would be left beside the manifest
+    // (scene 2, and scene 1, which a 2-scene dataset puts in val/).
     let r = generate(&out, "2", &["--resume"]);
-    failed_with(&r, "train/scene_0002");
+    failed_with(&r, "2 scene folder(s)");
     // Resuming the same size re-renders every unlisted scene: the result is the plain dataset.
     ok(generate(&out, "3", &["--resume"]));
     assert!(files(&out) == files(reference.path()));
@@ -249,7 +256,7 @@ fn resume_with_nothing_to_do_keeps_the_readme_and_empty_entries_never_verify() {
     let d = tmp();
     ok(generate(d.path(), "2", &[]));
     let readme = fs::read_to_string(d.path().join("README.md")).unwrap();
-    assert!(readme.contains("2 train"), "{readme}");
+    assert!(readme.contains("Scenes: 2 ("), "{readme}");
     ok(generate(d.path(), "2", &["--resume"]));
     assert_eq!(
         fs::read_to_string(d.path().join("README.md")).unwrap(),
@@ -278,4 +285,190 @@ fn a_gltf_node_scaled_beyond_any_room_is_refused_not_a_panic() {
     failed_with(&r, "matrix");
     assert!(!stderr(&r).contains("panicked"));
     assert!(!out.exists());
+}
+
+/// `name`s of every entry directly in `dir`, sorted.
+fn names(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn an_unsharded_run_never_overwrites_shards_that_were_not_merged() {
+    let (d, plain) = (tmp(), tmp());
+    let out = d.path().join("ds");
+    ok(generate(&out, "2", &["--seed", "1", "--shard", "0/2"]));
+    ok(generate(&out, "2", &["--seed", "1", "--shard", "1/2"]));
+    // Lock files come and go with the runs; everything else must stay.
+    let data = |out: &Path| {
+        let mut f = files(out);
+        f.retain(|k, _| !k.ends_with(".lock"));
+        f
+    };
+    let before = data(&out);
+    // Another seed, without and with --resume: refused, nothing touched.
+    let r = generate(&out, "2", &["--seed", "2"]);
+    failed_with(&r, "not merged");
+    failed_with(&r, "lfgen merge");
+    failed_with(&r, "--resume");
+    failed_with(&r, "another --out");
+    let r = generate(&out, "2", &["--seed", "2", "--resume"]);
+    failed_with(&r, "manifest.shard-0-of-2.json");
+    failed_with(&r, "another config or seed");
+    assert!(data(&out) == before, "a refused run changed the shards");
+    // The shards' own seed with --resume keeps their scenes (nothing rendered again) and
+    // completes the plain dataset.
+    ok(generate(&out, "2", &["--seed", "1", "--resume"]));
+    let timings = fs::read_to_string(out.join("timings.jsonl")).unwrap();
+    assert_eq!(timings.lines().count(), 2, "scenes were rendered again");
+    let mut joined = files(&out);
+    joined.retain(|k, _| !k.starts_with("manifest.shard-"));
+    ok(generate(plain.path(), "2", &["--seed", "1"]));
+    assert!(joined == files(plain.path()), "not the plain dataset");
+    // A shard of another seed beside the finished dataset is refused too.
+    fs::remove_file(out.join("manifest.shard-1-of-2.json")).unwrap();
+    let r = generate(&out, "2", &["--seed", "2", "--shard", "1/2", "--resume"]);
+    failed_with(&r, "another config or seed");
+}
+
+#[test]
+fn a_folder_that_is_no_dataset_is_never_written_into() {
+    let d = tmp();
+    let proj = d.path().join("proj");
+    fs::create_dir(&proj).unwrap();
+    fs::write(proj.join("README.md"), "notes").unwrap();
+    fs::write(proj.join("summary.json"), "{\"mine\": 1}").unwrap();
+    fs::write(proj.join("preview.png"), b"\x89PNG not really").unwrap();
+    let before = files(&proj);
+    for extra in [&[][..], &["--resume"][..]] {
+        let r = generate(&proj, "1", extra);
+        failed_with(&r, "not an lfgen dataset");
+        failed_with(&r, "README.md");
+        assert!(files(&proj) == before, "the user's files were changed");
+        assert_eq!(names(&proj), ["README.md", "preview.png", "summary.json"]);
+    }
+    // An empty folder, and a dataset whose manifest was lost, are lfgen's to write.
+    let empty = d.path().join("empty");
+    fs::create_dir(&empty).unwrap();
+    ok(generate(&empty, "1", &[]));
+    fs::remove_file(empty.join("manifest.json")).unwrap();
+    ok(generate(&empty, "1", &["--resume"]));
+}
+
+#[test]
+fn render_never_removes_temporary_names_it_did_not_make() {
+    let d = tmp();
+    let ds = d.path().join("ds");
+    ok(generate(&ds, "1", &[]));
+    let json = ds.join("train/scene_0000/scene.json");
+    let out = d.path().join("out");
+    for name in [".out.partial", ".out.old"] {
+        let mine = d.path().join(name);
+        fs::create_dir(&mine).unwrap();
+        fs::write(mine.join("notes.txt"), "keep me").unwrap();
+        let r = render(&json, &out);
+        failed_with(&r, name);
+        failed_with(&r, "did not make it");
+        assert_eq!(
+            fs::read_to_string(mine.join("notes.txt")).unwrap(),
+            "keep me"
+        );
+        assert_eq!(names(&mine), ["notes.txt"]);
+        assert!(!out.exists(), "{name}: a refused render wrote the scene");
+        fs::rename(&mine, d.path().join(format!("kept{name}"))).unwrap();
+    }
+    // With the names free, a render and a re-render replace only their own folders.
+    ok(render(&json, &out));
+    ok(render(&json, &out));
+    assert!(files(&out) == files(&ds.join("train/scene_0000")));
+    assert_eq!(
+        names(d.path()),
+        ["ds", "kept.out.old", "kept.out.partial", "out"]
+    );
+}
+
+#[test]
+fn merge_refuses_damaged_or_missing_shards_instead_of_dropping_them() {
+    let (d, plain) = (tmp(), tmp());
+    let out = d.path().join("ds");
+    ok(generate(&out, "4", &["--shard", "0/2"]));
+    ok(generate(&out, "4", &["--shard", "1/2"]));
+    let shard = Manifest::read(&out.join("manifest.shard-1-of-2.json")).unwrap();
+    let (one, three) = (&shard.scenes[0], &shard.scenes[1]);
+    // One flipped byte in scene 1, one deleted file in scene 3.
+    let flipped = out.join(&one.files[0].path);
+    let mut bytes = fs::read(&flipped).unwrap();
+    bytes[0] ^= 1;
+    fs::write(&flipped, bytes).unwrap();
+    fs::remove_file(out.join(&three.files[0].path)).unwrap();
+    let r = lfgen(&["merge", out.to_str().unwrap()]);
+    assert_eq!(r.status.code(), Some(1), "{}", stderr(&r));
+    failed_with(&r, "2 scene(s) do not verify");
+    for e in [one, three] {
+        failed_with(&r, &format!("scene {} ({})", e.index, e.dir));
+        failed_with(&r, &e.files[0].path);
+    }
+    assert!(
+        !out.join("manifest.json").exists(),
+        "a merge of damaged shards wrote a manifest"
+    );
+    // The shard's --resume renders the damaged scenes again; then the merge is the plain run.
+    ok(generate(&out, "4", &["--shard", "1/2", "--resume"]));
+    ok(lfgen(&["merge", out.to_str().unwrap()]));
+    let mut merged = files(&out);
+    merged.retain(|k, _| !k.starts_with("manifest.shard-"));
+    ok(generate(plain.path(), "4", &[]));
+    assert!(
+        merged == files(plain.path()),
+        "merged shards differ from one run"
+    );
+    // A shard that never ran fails the merge, naming it.
+    fs::remove_file(out.join("manifest.shard-0-of-2.json")).unwrap();
+    let r = lfgen(&["merge", out.to_str().unwrap()]);
+    failed_with(&r, "no manifest.shard-0-of-2.json");
+}
+
+/// Every line of `timings.jsonl` under `out` is one JSON object; their number.
+fn whole_timing_lines(out: &Path) -> usize {
+    let text = fs::read_to_string(out.join("timings.jsonl")).unwrap();
+    assert!(text.ends_with('\n'), "a cut-off last line: {text:?}");
+    for line in text.lines() {
+        let parsed = serde_json::from_str::<serde_json::Value>(line);
+        assert!(
+            parsed.is_ok_and(|v| v.is_object()),
+            "a broken line: {line:?}"
+        );
+    }
+    text.lines().count()
+}
+
+#[test]
+fn a_timing_line_cut_short_is_never_appended_to() {
+    // A line cut off by a kill or a full disk, then a resumed run.
+    let d = tmp();
+    ok(generate(d.path(), "1", &[]));
+    let log = d.path().join("timings.jsonl");
+    let mut text = fs::read(&log).unwrap();
+    text.extend_from_slice(b"{\"scene\": 1, \"sec");
+    fs::write(&log, text).unwrap();
+    ok(generate(d.path(), "2", &["--resume"]));
+    assert_eq!(whole_timing_lines(d.path()), 2);
+    // The second write to the log fails with ENOSPC: the run fails naming it, and the resumed
+    // run leaves only whole lines.
+    let d = tmp();
+    let out = d.path().join("ds");
+    let mut args = vec!["--scenes", "2", "--out", out.to_str().unwrap()];
+    args.extend_from_slice(TINY);
+    let inject = "inject=write:error=ENOSPC:when=2";
+    let Some(r) = with_failing_writes(&out.join("timings.jsonl"), inject, &args) else {
+        return;
+    };
+    failed_with(&r, "timings.jsonl");
+    failed_with(&r, "No space left on device");
+    ok(generate(&out, "2", &["--resume"]));
+    assert!(whole_timing_lines(&out) >= 1);
 }

@@ -1,9 +1,11 @@
-//! One scene folder (docs/conventions.md, Scene folder), written atomically: into `.NAME.partial`, then renamed.
+//! One scene folder (docs/reference/format.md, Scene folder), written atomically: into `.NAME.partial`, then renamed.
 //!
 //! While a scene is written its folder is locked (`.NAME.lock`, see [`Lock`]), so two runs
 //! never write into one partial folder. An existing folder at the final place is replaced only
 //! if it holds nothing but the files a scene writer writes: `--out` pointing at a dataset, a
 //! glTF's own folder or any other folder of the user's is refused before anything renders.
+//! The temporary folders `.NAME.partial` and `.NAME.old` carry a marker file while they exist,
+//! and a folder of either name without it is the user's: refused, never removed.
 
 use super::images::{ToneCurve, write_linear_exr, write_png};
 use crate::camera::LightFieldCamera;
@@ -25,6 +27,8 @@ use std::path::{Path, PathBuf};
 pub struct SceneWriter {
     final_dir: PathBuf,
     tmp_dir: PathBuf,
+    /// Where a previous scene at `final_dir` is moved while the new one takes its place.
+    old_dir: PathBuf,
     write_exr: bool,
     tone_curve: ToneCurve,
     /// Held until the folder is published (or the writer is dropped on an error).
@@ -55,15 +59,15 @@ impl SceneWriter {
         let lock = Lock::exclusive(&final_dir.with_file_name(format!(".{name}.lock")))?;
         check_replaceable(final_dir)?;
         let tmp_dir = final_dir.with_file_name(format!(".{name}.partial"));
-        if tmp_dir.exists() {
-            fs::remove_dir_all(&tmp_dir)
-                .with_context(|| format!("cannot remove stale {}", tmp_dir.display()))?;
-        }
-        fs::create_dir_all(&tmp_dir)
-            .with_context(|| format!("cannot create {}", tmp_dir.display()))?;
+        let old_dir = final_dir.with_file_name(format!(".{name}.old"));
+        remove_own_temporary(&tmp_dir)?;
+        remove_own_temporary(&old_dir)?;
+        fs::create_dir(&tmp_dir).with_context(|| format!("cannot create {}", tmp_dir.display()))?;
+        mark_temporary(&tmp_dir)?;
         Ok(Self {
             final_dir: final_dir.to_path_buf(),
             tmp_dir,
+            old_dir,
             write_exr,
             tone_curve,
             _lock: lock,
@@ -158,33 +162,82 @@ impl SceneWriter {
     }
 
     /// Renames the partial folder into place. A previous scene there (checked replaceable at
-    /// [`Self::create`], and again here) is first renamed aside and removed only after.
+    /// [`Self::create`], and again here) is first marked and renamed aside, and removed only
+    /// after; the new folder's marker goes last, so a run killed at any point leaves only
+    /// folders that the next one recognises as its own.
     fn publish(&self) -> Result<()> {
-        let old = match fs::symlink_metadata(&self.final_dir) {
-            Ok(_) => {
-                check_replaceable(&self.final_dir)?;
-                let old = self.tmp_dir.with_extension("old");
-                if old.exists() {
-                    fs::remove_dir_all(&old)
-                        .with_context(|| format!("cannot remove stale {}", old.display()))?;
-                }
-                fs::rename(&self.final_dir, &old)
-                    .with_context(|| format!("cannot replace {}", self.final_dir.display()))?;
-                Some(old)
-            }
-            Err(_) => None,
-        };
+        let replaced = fs::symlink_metadata(&self.final_dir).is_ok();
+        if replaced {
+            check_replaceable(&self.final_dir)?;
+            remove_own_temporary(&self.old_dir)?;
+            mark_temporary(&self.final_dir)?;
+            fs::rename(&self.final_dir, &self.old_dir)
+                .with_context(|| format!("cannot replace {}", self.final_dir.display()))?;
+        }
         fs::rename(&self.tmp_dir, &self.final_dir)
             .with_context(|| format!("cannot rename {} into place", self.tmp_dir.display()))?;
-        if let Some(old) = old {
-            fs::remove_dir_all(&old)
-                .with_context(|| format!("cannot remove the replaced {}", old.display()))?;
+        let marker = self.final_dir.join(TEMPORARY_MARKER);
+        fs::remove_file(&marker).with_context(|| format!("cannot remove {}", marker.display()))?;
+        if replaced {
+            remove_own_temporary(&self.old_dir)?;
         }
         Ok(())
     }
 }
 
-/// Fails unless `dir` is absent, or a folder holding only files a [`SceneWriter`] writes.
+/// The file that marks a folder as lfgen's own temporary one (a scene being written, or a
+/// previous scene being replaced): only folders holding it are ever removed, so a user's own
+/// `.NAME.partial` or `.NAME.old` beside `--out NAME` is never deleted.
+const TEMPORARY_MARKER: &str = ".lfgen-temporary";
+
+fn mark_temporary(dir: &Path) -> Result<()> {
+    let text = b"lfgen writes or removes this folder; it is not part of any scene\n";
+    Ok(lfformat::files::write_file(
+        &dir.join(TEMPORARY_MARKER),
+        text,
+    )?)
+}
+
+/// Removes `dir` if it is a temporary folder of lfgen's: marked with [`TEMPORARY_MARKER`] and
+/// holding only files (a scene folder is flat), or empty (a run killed before marking it).
+/// Anything else of that name is refused, naming it: it is the user's. The marker is removed
+/// last, so a removal cut short leaves a folder still recognised as lfgen's.
+fn remove_own_temporary(dir: &Path) -> Result<()> {
+    let in_the_way = |what: String| {
+        anyhow::anyhow!(
+            "{} {what}, and lfgen did not make it: lfgen needs this name for a temporary \
+             folder beside the scene; move or rename it",
+            dir.display()
+        )
+    };
+    match fs::symlink_metadata(dir) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => return Err(e).with_context(|| format!("cannot inspect {}", dir.display())),
+        Ok(m) if !m.is_dir() => return Err(in_the_way("exists and is not a folder".into())),
+        Ok(_) => {}
+    }
+    let mut names = Vec::new();
+    for entry in fs::read_dir(dir).with_context(|| format!("cannot list {}", dir.display()))? {
+        let entry = entry.with_context(|| format!("cannot list {}", dir.display()))?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if !entry.file_type().is_ok_and(|t| t.is_file()) {
+            return Err(in_the_way(format!("holds {name:?}, which is not a file")));
+        }
+        names.push(name);
+    }
+    if !names.is_empty() && !names.iter().any(|n| n == TEMPORARY_MARKER) {
+        return Err(in_the_way(format!("holds {:?}", names[0])));
+    }
+    names.sort_by_key(|n| n == TEMPORARY_MARKER);
+    for name in names {
+        let path = dir.join(name);
+        fs::remove_file(&path).with_context(|| format!("cannot remove {}", path.display()))?;
+    }
+    fs::remove_dir(dir).with_context(|| format!("cannot remove {}", dir.display()))
+}
+
+/// Fails unless `dir` is absent, or a folder holding only files a [`SceneWriter`] writes (and
+/// perhaps the temporary marker of a run killed just as it published the folder).
 pub fn check_replaceable(dir: &Path) -> Result<()> {
     let meta = match fs::symlink_metadata(dir) {
         Ok(m) => m,
@@ -201,7 +254,7 @@ pub fn check_replaceable(dir: &Path) -> Result<()> {
         let entry = entry.with_context(|| format!("cannot list {}", dir.display()))?;
         let name = entry.file_name().to_string_lossy().into_owned();
         let is_file = entry.file_type().is_ok_and(|t| t.is_file());
-        if !is_file || !is_scene_file(&name) {
+        if !is_file || !(is_scene_file(&name) || name == TEMPORARY_MARKER) {
             bail!(
                 "{} already holds {name:?}, which is not a file of an lfgen scene: lfgen \
                  replaces only a previous scene folder; choose a new or empty folder",
@@ -273,7 +326,7 @@ pub fn list_files(dir: &Path, root: &Path) -> Result<Vec<FileEntry>> {
         .collect()
 }
 
-/// HCI `parameters.cfg` of a scene (docs/conventions.md, Scene folder).
+/// HCI `parameters.cfg` of a scene (docs/reference/format.md, Scene folder).
 fn hci_parameters(desc: &SceneDesc, stats: &SceneStats) -> HciParameters {
     let cam = &desc.camera;
     let [px, py, pz] = cam.blender_position();
