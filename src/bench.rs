@@ -1,5 +1,7 @@
-//! `lfgen bench`: throughput of the ray queries and the cost of the 128-slice ground truth,
-//! as ratios measured in one run (absolute figures on a shared machine are noise).
+//! `lfgen bench speed`: throughput of the ray queries and the cost of the 128-slice ground
+//! truth, as ratios measured in one run (absolute figures on a shared machine are noise);
+//! `lfgen bench quality`: the views' error against a converged render. Both print their figures
+//! and return them as data for the results file (`lfformat::results`).
 
 use crate::config::{Config, ShadingMode};
 use crate::output::images::{ToneCurve, write_linear_exr, write_png};
@@ -11,6 +13,7 @@ use crate::render::view::{Adaptive, RenderSettings};
 use anyhow::{Context, Result};
 use glam::Vec3;
 use rayon::prelude::*;
+use serde_json::{Value, json};
 use std::path::Path;
 use std::sync::atomic::AtomicU64;
 use std::time::Instant;
@@ -18,8 +21,9 @@ use std::time::Instant;
 /// Image side of the benchmark view: big enough for stable timings, small enough for seconds.
 const BENCH_RES: u32 = 192;
 
-/// Runs the benchmark on scene 0 of `cfg` (resolution fixed to 192², other settings as given).
-pub fn run(cfg: &Config) -> Result<()> {
+/// Runs the speed benchmark on scene 0 of `cfg` (resolution fixed to 192², other settings as
+/// given) and returns its figures.
+pub fn speed(cfg: &Config) -> Result<Value> {
     let mut cfg = cfg.clone();
     cfg.camera.resolution = [BENCH_RES, BENCH_RES];
     let (desc, scene) = generate_scene(&cfg, 0, None)?;
@@ -67,6 +71,14 @@ pub fn run(cfg: &Config) -> Result<()> {
         })
     });
     let n = (pixels.len() * reps as usize) as f64;
+    let mut figures = json!({
+        "threads": rayon::current_num_threads(),
+        "size": BENCH_RES,
+        "spp": cfg.render.spp,
+        "closest_mrays_per_s": n / closest / 1e6,
+        "all_hits_mrays_per_s": n / all / 1e6,
+        "all_hits_cost_ratio": all / closest,
+    });
     lfformat::say!(
         "closest hit (stochastic opacity): {:.2} Mrays/s",
         n / closest / 1e6
@@ -120,9 +132,12 @@ pub fn run(cfg: &Config) -> Result<()> {
             with_gt / colour
         )?;
         ratio = with_gt / colour;
+        figures[format!("{name}_colour_s")] = json!(colour);
+        figures[format!("{name}_with_gt_s")] = json!(with_gt);
     }
     lfformat::say!("gt_overhead_ratio: {ratio:.3}")?;
-    Ok(())
+    figures["gt_overhead_ratio"] = json!(ratio);
+    Ok(figures)
 }
 
 fn time(f: impl FnOnce()) -> f64 {
@@ -137,10 +152,11 @@ const REFERENCE_SPP: u32 = 1024;
 /// renders they score.
 const REFERENCE_SALT: u64 = 0x2EF0;
 
-/// `lfgen bench --quality`: for built-in scenes `scenes` at `size`², the centre view of the
+/// `lfgen bench quality`: for built-in scenes `scenes` at `size`², the centre view of the
 /// configured settings, shared and independent side by side, against a converged independent
-/// render: PSNR, the photo-consistency residual of the adjacent view, and the time.
-pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -> Result<()> {
+/// render: PSNR, the photo-consistency residual of the adjacent view, and the time. Returns
+/// the table's rows as figures.
+pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -> Result<Value> {
     if let Some(dir) = images {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     }
@@ -151,6 +167,7 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
          (vs truth) | photo residual (8-bit levels) | s per scene | per-view noise share: \
          linear / 8-bit | pixels given adaptive samples | cache noise share: linear / 8-bit"
     )?;
+    let mut rows = Vec::new();
     for &index in scenes {
         let (desc, scene) = generate_scene(&cfg, index, None)?;
         let cam = &desc.camera;
@@ -188,11 +205,11 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
         let mse =
             |a: &[Vec3], b: &[Vec3]| [mse_linear(a, b, exposure), mse_8bit(a, b, exposure, tone)];
         let own_noise = mse(a_px, b_px).map(reference_noise);
+        // PSNR against the reference and (estimated) against the truth, linear and 8-bit.
         let score = |mse: [f64; 2]| {
             let peak = [1.0, 255.0 * 255.0];
             let psnr = |k: usize, mse: f64| 10.0 * (peak[k] / mse).log10();
-            let truth = |k: usize| psnr(k, mse_to_truth(mse[k], own_noise[k]));
-            [0, 1].map(|k| format!("{:.1} ({:.1})", psnr(k, mse[k]), truth(k)))
+            [0, 1].map(|k| [psnr(k, mse[k]), psnr(k, mse_to_truth(mse[k], own_noise[k]))])
         };
         let [w, h] = cam.resolution.map(|n| n as usize);
         let write = |name: &str, pixels: &[Vec3]| -> Result<()> {
@@ -232,6 +249,13 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
             "{index} | converged ({REFERENCE_SPP} spp) | ({own_linear:.1}) | ({own_8bit:.1}) | \
              {floor:.2} | –"
         )?;
+        rows.push(json!({
+            "scene": index,
+            "shading": "converged",
+            "psnr_linear_truth": own_linear,
+            "psnr_8bit_truth": own_8bit,
+            "photo_residual": floor,
+        }));
         for shading in [ShadingMode::Shared, ShadingMode::Independent] {
             job.shading = shading;
             let mut settings = job.settings(&desc);
@@ -264,6 +288,8 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
             write(&format!("{shading:?}").to_lowercase(), &c)?;
             let to_reference = mse(&c, &reference);
             let [linear, eight_bit] = score(to_reference);
+            let shown =
+                |[vs_reference, vs_truth]: [f64; 2]| format!("{vs_reference:.1} ({vs_truth:.1})");
             // The centre view again from other camera seeds but the same cache: the two
             // differ only by the noise that is the view's own.
             let seed = settings.seed ^ PER_VIEW_SALT;
@@ -279,7 +305,7 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
             // seeds: the two differ by the cache's noise alone; what neither noise explains is
             // the cache's bias (its blur over a cell, the fit of the shared lobes).
             let cache_share = match &cache {
-                None => "–".to_owned(),
+                None => None,
                 Some(_) => {
                     let fill = RenderSettings {
                         seed: settings.seed ^ CACHE_SALT,
@@ -297,19 +323,38 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
                     );
                     write("shared_other_cache", &out.image.pixels)?;
                     let between = mse(&c, &out.image.pixels);
-                    format!("{:.0} % / {:.0} %", share(between, 0), share(between, 1))
+                    Some([share(between, 0), share(between, 1)])
                 }
             };
+            let residual =
+                photo_residual(&c, &adjacent, &disparity, &gt.modes, [w, h], exposure, tone);
+            let per_view = [share(per_view, 0), share(per_view, 1)];
+            let cache_shown =
+                cache_share.map_or("–".to_owned(), |[l, e]| format!("{l:.0} % / {e:.0} %"));
             lfformat::say!(
-                "{index} | {shading:?} | {linear} | {eight_bit} | {:.2} | {scene_s:.1} | {:.0} % / {:.0} % \
-                 | {refined:.1} % | {cache_share}",
-                photo_residual(&c, &adjacent, &disparity, &gt.modes, [w, h], exposure, tone),
-                share(per_view, 0),
-                share(per_view, 1),
+                "{index} | {shading:?} | {} | {} | {residual:.2} | {scene_s:.1} | {:.0} % / {:.0} % \
+                 | {refined:.1} % | {cache_shown}",
+                shown(linear),
+                shown(eight_bit),
+                per_view[0],
+                per_view[1],
             )?;
+            rows.push(json!({
+                "scene": index,
+                "shading": format!("{shading:?}").to_lowercase(),
+                "psnr_linear": linear[0],
+                "psnr_linear_truth": linear[1],
+                "psnr_8bit": eight_bit[0],
+                "psnr_8bit_truth": eight_bit[1],
+                "photo_residual": residual,
+                "seconds_per_scene": scene_s,
+                "per_view_noise_share_pct": per_view,
+                "adaptive_pixels_pct": refined,
+                "cache_noise_share_pct": cache_share,
+            }));
         }
     }
-    Ok(())
+    Ok(json!({ "size": size, "spp": cfg.render.spp, "rows": rows }))
 }
 
 /// Salt of the second render of a view that measures its own noise ([`noise_share`]).

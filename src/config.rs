@@ -40,7 +40,8 @@ pub struct DatasetConfig {
     /// Master seed; every random choice derives from (seed, scene index, view, pixel).
     pub seed: u64,
     /// Scene `i` goes to `val` when `i % val_every == val_every - 1`, else to `train`
-    /// (110 scenes give the thesis' 100/10 split). 0 puts every scene in `train`.
+    /// (110 scenes give the thesis' 100/10 split); a dataset of fewer than `val_every` scenes
+    /// puts its last one in `val` (none with a single scene). 0 puts every scene in `train`.
     pub val_every: u64,
     /// Default output folder.
     pub out: String,
@@ -86,7 +87,7 @@ pub enum BaselineMode {
     Fixed,
 }
 
-/// The light-field camera grid (HCI conventions, docs/conventions.md).
+/// The light-field camera grid (HCI conventions, docs/reference/format.md).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct CameraConfig {
@@ -293,20 +294,36 @@ impl Config {
     }
 }
 
-/// Named bundles of overrides, applied before the user's `--set`s.
-pub const PRESETS: &[(&str, &[&str])] = &[
-    ("full", &[]),
-    (
-        "quick",
-        &[
+/// A named bundle of overrides (`--preset NAME`), applied before the user's `--set`s.
+#[derive(Clone, Copy, Debug)]
+pub struct Preset {
+    pub name: &'static str,
+    /// One line for `--help` and the reference.
+    pub about: &'static str,
+    pub sets: &'static [&'static str],
+}
+
+/// The presets; without one, the defaults (generator.toml) make the full-size dataset.
+pub const PRESETS: &[Preset] = &[
+    Preset {
+        name: "quick",
+        about: "128² views at 10 + 30 spp: a small dataset in minutes",
+        sets: &[
             "camera.resolution=[128,128]",
             "render.spp=10",
             "render.adaptive_spp=30",
         ],
-    ),
-    ("wide", &["camera.disparity_range=[-40.0,40.0]"]),
-    // Views at 40 dB for 1.6x the time (crates/lfrender/README.md, "Views at 40 dB").
-    ("clean", &["render.final_gather=true", "render.cache_spp=2"]),
+    },
+    Preset {
+        name: "wide",
+        about: "disparities of ±40 px instead of ±3.5 (wide baselines)",
+        sets: &["camera.disparity_range=[-40.0,40.0]"],
+    },
+    Preset {
+        name: "clean",
+        about: "views at about 40 dB for 1.6× the time (a final gather, 2 fill spp)",
+        sets: &["render.final_gather=true", "render.cache_spp=2"],
+    },
 ];
 
 /// Largest samples per pixel.
@@ -343,11 +360,11 @@ impl Config {
             None => toml::Table::new(),
         };
         for name in presets {
-            let (_, sets) = PRESETS.iter().find(|(n, _)| n == name).with_context(|| {
-                let known: Vec<_> = PRESETS.iter().map(|(n, _)| *n).collect();
+            let preset = PRESETS.iter().find(|p| p.name == name).with_context(|| {
+                let known: Vec<_> = PRESETS.iter().map(|p| p.name).collect();
                 format!("unknown preset {name:?} (known: {})", known.join(", "))
             })?;
-            for s in *sets {
+            for s in preset.sets {
                 apply_set(&mut table, s)?;
             }
         }

@@ -2,14 +2,24 @@
 //! library function per command, report errors once.
 
 use anyhow::{Context, Result, bail};
-use clap::{Args, Parser, Subcommand};
-use lfgen::config::Config;
+use clap::builder::{PossibleValue, PossibleValuesParser};
+use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand};
+use lfgen::config::{Config, PRESETS};
 use lfgen::dataset::{self, GenerateOptions};
-use std::path::PathBuf;
+use lfgen::export::Target;
+use std::path::{Path, PathBuf};
 
-/// Generate multimodal light-field depth datasets (HCI format + 128-slice multimodal GT).
+/// Generate multimodal light-field depth datasets: HCI-format light fields with 128-slice
+/// multimodal ground truth, path-traced on the CPU.
 #[derive(Parser, Debug)]
-#[command(version, about, args_conflicts_with_subcommands = true)]
+#[command(
+    name = "lfgen",
+    version,
+    args_conflicts_with_subcommands = true,
+    override_usage = "lfgen <COMMAND> [OPTIONS]\n       lfgen [GENERATE OPTIONS]",
+    after_help = "Without a command, lfgen generates: `lfgen --scenes 4` is `lfgen generate \
+                  --scenes 4` (see `lfgen generate --help`)."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
@@ -19,6 +29,8 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// Render a dataset of procedural rooms into train/ and val/ scene folders.
+    Generate(GenerateArgs),
     /// Render a glTF 2.0 scene, or re-render a saved scene.json, into a scene folder.
     Render(RenderArgs),
     /// Union shard manifests (and verify scenes) into one manifest.json.
@@ -26,8 +38,11 @@ enum Command {
         /// Dataset folder.
         dataset: PathBuf,
     },
-    /// Measure rays/s and the cost of the 128-slice ground truth on a fixed built-in scene.
-    Bench(BenchArgs),
+    /// Write a contact sheet per scene and an overview page into DATASET/previews/.
+    Preview {
+        /// Dataset folder (with manifest.json).
+        dataset: PathBuf,
+    },
     /// Write a saved scene (SCENE_DIR/scene.json) for POV-Ray, Blender or Mitsuba 3.
     Export(ExportArgs),
     /// Write the procedural seamless texture library as PNGs plus catalog.json.
@@ -42,16 +57,33 @@ enum Command {
         #[arg(long, default_value_t = 0)]
         seed: u64,
     },
-    /// Write a contact sheet per scene and an overview page into DATASET/previews/.
-    Preview {
-        /// Dataset folder (with manifest.json).
-        dataset: PathBuf,
-    },
     /// Download external model libraries and convert them into an asset catalogue.
     Assets {
         #[command(subcommand)]
         command: AssetsCommand,
     },
+    /// Measure speed or image quality on built-in scenes; each run appends its figures to a
+    /// results file.
+    Bench {
+        #[command(subcommand)]
+        kind: BenchKind,
+    },
+    /// Print a shell completion script, e.g. `lfgen completions bash > lfgen.bash`.
+    Completions { shell: clap_complete::Shell },
+    /// Print the man page (roff), e.g. `lfgen man > lfgen.1`.
+    Man,
+    /// Print a generated reference page of docs/reference/.
+    #[command(hide = true)]
+    Doc { page: DocPage },
+}
+
+/// The generated reference pages.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+enum DocPage {
+    /// docs/reference/cli.md: every command and flag.
+    Cli,
+    /// docs/reference/config.md: every config key and preset.
+    Config,
 }
 
 #[derive(Subcommand, Debug)]
@@ -83,11 +115,14 @@ struct FetchArgs {
 /// Options shared by every command that loads a config.
 #[derive(Args, Debug, Clone)]
 struct ConfigArgs {
-    /// Config file (default: ./generator.toml if present, else built-in defaults).
-    #[arg(long)]
+    /// Config file (default: ./generator.toml if present, else the built-in defaults).
+    #[arg(long, conflicts_with = "no_config")]
     config: Option<PathBuf>,
-    /// Named override bundle applied before --set: full, quick, wide, clean (repeatable).
+    /// Ignore ./generator.toml: start from the built-in defaults.
     #[arg(long)]
+    no_config: bool,
+    /// Named bundle of overrides applied before --set (repeatable; later ones win).
+    #[arg(long, value_parser = preset_names())]
     preset: Vec<String>,
     /// Override any config key, e.g. --set camera.resolution=[64,64] (repeatable).
     #[arg(long = "set", value_name = "SECTION.KEY=VALUE")]
@@ -100,9 +135,21 @@ struct ConfigArgs {
     quiet: bool,
 }
 
+/// The presets the config knows, with their one-line descriptions, for parsing, `--help` and
+/// completions.
+fn preset_names() -> PossibleValuesParser {
+    PossibleValuesParser::new(
+        PRESETS
+            .iter()
+            .map(|p| PossibleValue::new(p.name).help(p.about)),
+    )
+}
+
 #[derive(Args, Debug)]
 struct GenerateArgs {
-    /// Number of scenes (default: dataset.scenes of the config).
+    /// Number of scenes (default: dataset.scenes of the config). Every 11th scene
+    /// (dataset.val_every) goes to val/, the rest to train/; a smaller dataset puts its last
+    /// scene in val/.
     #[arg(long)]
     scenes: Option<u64>,
     /// Output dataset folder (default: dataset.out of the config).
@@ -111,7 +158,7 @@ struct GenerateArgs {
     /// Dataset seed (overrides dataset.seed).
     #[arg(long)]
     seed: Option<u64>,
-    /// Render only scenes with index % N == I, e.g. 0/4.
+    /// Render only scenes with index % N == I, e.g. 0/4; `lfgen merge` joins the shards.
     #[arg(long, value_name = "I/N")]
     shard: Option<String>,
     /// Keep scenes whose files verify against the manifest, redo the rest.
@@ -141,9 +188,9 @@ struct RenderArgs {
 
 #[derive(Args, Debug)]
 struct ExportArgs {
-    /// Target renderer: pov, blender or mitsuba.
-    #[arg(long)]
-    to: String,
+    /// Target renderer.
+    #[arg(long, value_enum)]
+    to: Target,
     /// Scene folder holding scene.json.
     scene_dir: PathBuf,
     /// Output folder.
@@ -157,44 +204,73 @@ struct ExportArgs {
     common: ConfigArgs,
 }
 
+#[derive(Subcommand, Debug)]
+enum BenchKind {
+    /// Rays/s and the cost of the 128-slice ground truth, on built-in scene 0 at 192².
+    Speed {
+        #[command(flatten)]
+        results: ResultsArg,
+        #[command(flatten)]
+        common: ConfigArgs,
+    },
+    /// Image quality: the centre view's PSNR against a converged render, the
+    /// photo-consistency residual and the time, shared and independent shading side by side.
+    Quality(QualityArgs),
+}
+
 #[derive(Args, Debug)]
-struct BenchArgs {
-    /// Image quality instead of speed: PSNR against a converged render, the photo-consistency
-    /// residual and the time, shared and independent shading side by side.
-    #[arg(long)]
-    quality: bool,
-    /// Built-in scenes of the quality benchmark.
+struct QualityArgs {
+    /// Built-in scenes to measure.
     #[arg(long, value_delimiter = ',', default_value = "0,1,2")]
     scenes: Vec<u64>,
-    /// Quality benchmark: image side in pixels (the default is the size of issue 14's
-    /// measurements; at the dataset's 512² the auto baseline is narrower, so more glossy
-    /// lobes are shared, and the reference takes 16× as long).
+    /// Image side in pixels (the reference takes 16× as long at 512² as at 128²).
     #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u32).range(16..=4096))]
     size: u32,
-    /// Quality benchmark: also write each scene's centre views (reference, shared,
-    /// independent, and each shading's second render `*_again`, whose difference from the
-    /// first is the view's own noise; linear EXR and tone-mapped PNG) into this folder.
+    /// Also write each scene's centre views (reference, shared, independent, and each
+    /// shading's second render `*_again`, whose difference from the first is the view's own
+    /// noise; linear EXR and tone-mapped PNG) into this folder.
     #[arg(long)]
-    images: Option<std::path::PathBuf>,
+    images: Option<PathBuf>,
+    #[command(flatten)]
+    results: ResultsArg,
     #[command(flatten)]
     common: ConfigArgs,
 }
 
+/// Where a benchmark's record goes.
+#[derive(Args, Debug)]
+struct ResultsArg {
+    /// Results file the run appends its figures to, one JSON line (docs/reference/results.md).
+    #[arg(long, value_name = "FILE", default_value = lfformat::results::DEFAULT_PATH)]
+    results: PathBuf,
+}
+
+/// The command line, with the generation flags of bare `lfgen` hidden from `lfgen --help`
+/// (they are `lfgen generate`'s, listed there).
+fn command() -> clap::Command {
+    Cli::command().mut_args(|a| a.hide(true))
+}
+
 fn main() {
-    if let Err(e) = run(Cli::parse()) {
+    let cli = Cli::from_arg_matches(&command().get_matches()).unwrap_or_else(|e| e.exit());
+    if let Err(e) = run(cli) {
         lfformat::note!("error: {e:#}");
         std::process::exit(1);
     }
 }
 
 fn run(cli: Cli) -> Result<()> {
-    match cli.command {
-        Some(Command::Render(a)) => {
+    let Some(chosen) = cli.command else {
+        return generate(cli.generate);
+    };
+    match chosen {
+        Command::Generate(a) => generate(a),
+        Command::Render(a) => {
             let cfg = load(&a.common)?;
             let camera = a.camera.as_deref();
             lfgen::pipeline::render_file(&cfg, &a.scene, camera, &a.out, a.common.quiet)
         }
-        Some(Command::Textures { count, out, seed }) => {
+        Command::Textures { count, out, seed } => {
             let cat = lfgen::output::texture_library::write_library(&out, count, seed)?;
             lfformat::say!(
                 "{}: {} textures and catalog.json",
@@ -203,7 +279,7 @@ fn run(cli: Cli) -> Result<()> {
             )?;
             Ok(())
         }
-        Some(Command::Preview { dataset }) => {
+        Command::Preview { dataset } => {
             let n = lfgen::output::preview::write_contact_sheets(&dataset)?;
             lfformat::say!(
                 "{}: {n} contact sheets and index.html",
@@ -211,16 +287,16 @@ fn run(cli: Cli) -> Result<()> {
             )?;
             Ok(())
         }
-        Some(Command::Assets {
+        Command::Assets {
             command: AssetsCommand::Fetch(a),
-        }) => {
+        } => {
             let summary = match a.source {
                 AssetSource::Sweethome3d => lfgen::catalog::sweethome3d::fetch(&a.out, a.nonfree)?,
             };
             lfformat::console::stdout(format_args!("{summary}"))?;
             Ok(())
         }
-        Some(Command::Merge { dataset }) => {
+        Command::Merge { dataset } => {
             let m = dataset::merge(&dataset)?;
             lfformat::say!(
                 "{}: manifest.json with {} verified scenes",
@@ -229,28 +305,74 @@ fn run(cli: Cli) -> Result<()> {
             )?;
             Ok(())
         }
-        Some(Command::Bench(a)) => {
+        Command::Bench { kind } => bench(kind),
+        Command::Export(a) => {
             let cfg = load(&a.common)?;
-            match a.quality {
-                true => lfgen::bench::quality(&cfg, &a.scenes, a.size, a.images.as_deref()),
-                false => lfgen::bench::run(&cfg),
-            }
-        }
-        Some(Command::Export(a)) => {
-            let cfg = load(&a.common)?;
-            let target = lfgen::export::Target::parse(&a.to)?;
             let views = lfgen::export::extract::ViewSelection::parse(&a.views)?;
             let limits = lfgen::export::PathLimits {
                 max_depth: cfg.render.max_depth,
                 rr_depth: cfg.render.rr_depth,
             };
-            lfgen::export::export_scene_dir(&a.scene_dir, target, &a.out, &views, limits)
+            lfgen::export::export_scene_dir(&a.scene_dir, a.to, &a.out, &views, limits)
         }
-        None => generate(cli.generate),
+        Command::Completions { shell } => {
+            let mut script = Vec::new();
+            clap_complete::generate(shell, &mut command(), "lfgen", &mut script);
+            print_bytes(&script)
+        }
+        Command::Man => {
+            let mut page = Vec::new();
+            clap_mangen::Man::new(command()).render(&mut page)?;
+            print_bytes(&page)
+        }
+        Command::Doc { page } => {
+            let text = match page {
+                DocPage::Cli => cli_markdown(),
+                DocPage::Config => lfgen::reference::config_markdown(),
+            };
+            print_bytes(text.as_bytes())
+        }
     }
 }
 
-/// Loads the config and sets up the thread pool.
+/// Writes generated text to standard output (an error if it cannot be written).
+fn print_bytes(bytes: &[u8]) -> Result<()> {
+    lfformat::console::stdout(format_args!("{}", String::from_utf8_lossy(bytes)))?;
+    Ok(())
+}
+
+/// docs/reference/cli.md: every command and flag, from the definitions above.
+fn cli_markdown() -> String {
+    let options = clap_markdown::MarkdownOptions::new()
+        .title("`lfgen` command-line reference".into())
+        .show_footer(false);
+    let generated = "Generated from the flag definitions by `lfgen doc cli` (do not edit by \
+                     hand: run `lfgen doc cli > docs/reference/cli.md`). `lftrain` and \
+                     `lfeval`: [cli-lftrain.md](cli-lftrain.md), [cli-lfeval.md](cli-lfeval.md).";
+    let md = clap_markdown::help_markdown_command_custom(&command(), &options);
+    md.replacen("\n\n", &format!("\n\n{generated}\n\n"), 1)
+}
+
+/// Runs a benchmark and appends its record to the results file.
+fn bench(kind: BenchKind) -> Result<()> {
+    let (figures, results) = match kind {
+        BenchKind::Speed { results, common } => (lfgen::bench::speed(&load(&common)?)?, results),
+        BenchKind::Quality(a) => {
+            let cfg = load(&a.common)?;
+            let images = a.images.as_deref();
+            (
+                lfgen::bench::quality(&cfg, &a.scenes, a.size, images)?,
+                a.results,
+            )
+        }
+    };
+    lfformat::results::Record::now("lfgen", figures).append(&results.results)?;
+    lfformat::note!("figures appended to {}", results.results.display());
+    Ok(())
+}
+
+/// Loads the config and sets up the thread pool. An implicit ./generator.toml is announced, so
+/// a file left in the working directory never changes a run unnoticed.
 fn load(a: &ConfigArgs) -> Result<Config> {
     if let Some(n) = a.threads {
         if n == 0 || n > MAX_THREADS {
@@ -261,12 +383,19 @@ fn load(a: &ConfigArgs) -> Result<Config> {
             .build_global()
             .context("cannot set --threads")?;
     }
-    let default = PathBuf::from("generator.toml");
-    let path = a
-        .config
-        .clone()
-        .or_else(|| default.exists().then_some(default));
-    Config::load(path.as_deref(), &a.preset, &a.sets)
+    let default = Path::new("generator.toml");
+    let path = match (&a.config, a.no_config) {
+        (Some(path), _) => Some(path.as_path()),
+        (None, false) if default.exists() => {
+            lfformat::note!(
+                "using ./generator.toml (pass --config FILE to choose another, --no-config to \
+                 ignore it)"
+            );
+            Some(default)
+        }
+        (None, _) => None,
+    };
+    Config::load(path, &a.preset, &a.sets)
 }
 
 /// More worker threads than this only cost memory (each keeps per-pixel buffers).
@@ -298,8 +427,37 @@ fn generate(a: GenerateArgs) -> Result<()> {
         strict: a.strict,
     };
     dataset::generate(&cfg, &opts)?;
-    lfformat::note!("dataset written to {}", opts.out.display());
+    lfformat::note!("{}", next_steps(&cfg, &opts));
     Ok(())
+}
+
+/// Where the data is and what to run on it next.
+fn next_steps(cfg: &Config, opts: &GenerateOptions) -> String {
+    let out = opts.out.display();
+    let (i, n) = opts.shard;
+    if n > 1 {
+        return format!(
+            "shard {i}/{n} written to {out}; once every shard is done: lfgen merge {out}"
+        );
+    }
+    let val = (0..opts.scenes)
+        .filter(|&k| dataset::split_of(cfg, k, opts.scenes) == "val")
+        .count() as u64;
+    let train = opts.scenes - val;
+    let mut text = format!("dataset written to {out}: {train} scenes in train/, {val} in val/");
+    if val == 0 {
+        text += "\nno val/ split: it needs at least 2 scenes (and dataset.val_every > 0)";
+        return text;
+    }
+    text += &format!(
+        "\nnext, train a model and evaluate it beside the classical baseline:\n  \
+         lftrain train --train {out}/train --val {out}/val \
+         --config crates/lftrain/configs/quickstart.toml --out runs/quickstart\n  \
+         lftrain predict runs/quickstart {out}/val --out predictions/model\n  \
+         lfeval baseline {out}/val --out predictions/baseline\n  \
+         lfeval {out}/val predictions/model predictions/baseline --out report"
+    );
+    text
 }
 
 fn parse_shard(s: &str) -> Result<(u64, u64)> {

@@ -281,7 +281,7 @@ fn bad_input_gives_clear_errors_and_no_scene() {
         (&["--set", "render.sppp=4"], "render.sppp"),
         (&["--set", "render.spp=many"], "render"),
         (&["--set", "camera.grid=[4,4]"], "odd"),
-        (&["--preset", "huge"], "unknown preset"),
+        (&["--preset", "huge"], "invalid value 'huge'"),
         (&["--shard", "3/2"], "--shard"),
     ];
     for (args, needle) in cases {
@@ -426,7 +426,7 @@ fn rays_through_windows_and_doors_end_on_a_surface() {
     assert_eq!(seen, [true, true], "windows and doors");
 }
 
-/// `lfgen bench --quality` end to end at a tiny size: the converged row and both shadings, each
+/// `lfgen bench quality` end to end at a tiny size: the converged row and both shadings, each
 /// with the share of its error that is its view's own noise, and shared shading's cache noise
 /// share. The independent estimator has no
 /// shared part, so all of its error is its own: at 128² the bench finds 100 % (linear); on
@@ -437,8 +437,16 @@ fn rays_through_windows_and_doors_end_on_a_surface() {
 fn the_quality_bench_scores_both_shadings_with_their_error_budget() {
     let images = tmp();
     let dir = images.path().to_str().unwrap();
-    let args = ["bench", "--quality", "--size", "24", "--scenes", "0"];
-    let out = ok(lfgen(&args, &["--images", dir, "-q"]));
+    let results = images.path().join("results.jsonl");
+    let args = ["bench", "quality", "--size", "24", "--scenes", "0"];
+    let extra = [
+        "--images",
+        dir,
+        "-q",
+        "--results",
+        results.to_str().unwrap(),
+    ];
+    let out = ok(lfgen(&args, &extra));
     let table = String::from_utf8_lossy(&out.stdout).into_owned();
     let row = |name: &str| -> Vec<String> {
         let line = (table.lines())
@@ -469,7 +477,114 @@ fn the_quality_bench_scores_both_shadings_with_their_error_budget() {
         let path = images.path().join(format!("scene0_{name}.png"));
         assert!(path.exists(), "{} missing", path.display());
     }
-    let small = lfgen(&["bench", "--quality", "--size", "8"], &[]);
+    // The run's figures, as one record of the results file.
+    let text = fs::read_to_string(&results).unwrap();
+    let record: serde_json::Value = serde_json::from_str(text.trim_end()).unwrap();
+    assert_eq!(text.lines().count(), 1, "{text}");
+    assert_eq!(record["tool"], "lfgen");
+    assert_eq!(record["command"][1], "bench", "{record}");
+    let rows = record["figures"]["rows"].as_array().unwrap();
+    let shared = rows.iter().find(|r| r["shading"] == "shared").unwrap();
+    assert!(shared["psnr_linear"].as_f64().unwrap() > 0.0, "{record}");
+    assert_eq!(record["figures"]["size"], 24);
+    let small = lfgen(&["bench", "quality", "--size", "8"], &[]);
     assert!(!small.status.success());
     assert!(stderr(&small).contains("--size"), "{}", stderr(&small));
+}
+
+/// A dataset of any size from 2 scenes on has a val/ split (the last scene below 11 scenes),
+/// shards agree on it, and the run ends by saying where the data is and what to run next; one
+/// scene says why there is no val/. `lfgen generate` is bare `lfgen`.
+#[test]
+fn small_datasets_get_a_val_split_and_the_run_names_the_next_commands() {
+    let (whole, sharded, named) = (tmp(), tmp(), tmp());
+    let out = ok(generate(whole.path(), "2", &[]));
+    let m = Manifest::read(&whole.path().join("manifest.json")).unwrap();
+    let dirs: Vec<&str> = m.scenes.iter().map(|e| e.dir.as_str()).collect();
+    assert_eq!(dirs, ["train/scene_0000", "val/scene_0001"]);
+    let said = stderr(&out);
+    let val = format!("{}/val", whole.path().display());
+    assert!(said.contains("1 scenes in train/, 1 in val/"), "{said}");
+    assert!(
+        said.contains("lftrain train --train") && said.contains(&val),
+        "{said}"
+    );
+    assert!(said.contains(&format!("lfeval baseline {val}")), "{said}");
+    for shard in ["0/2", "1/2"] {
+        let said = stderr(&ok(generate(sharded.path(), "2", &["--shard", shard])));
+        assert!(said.contains("lfgen merge"), "{said}");
+    }
+    ok(lfgen(&["merge", sharded.path().to_str().unwrap()], &[]));
+    let mut b = files(sharded.path());
+    b.retain(|k, _| !k.starts_with("manifest.shard-"));
+    assert!(
+        files(whole.path()) == b,
+        "merged shards differ from one run"
+    );
+    let o = named.path().to_str().unwrap();
+    ok(lfgen(&["generate", "--scenes", "2", "--out", o], TINY));
+    assert!(
+        files(whole.path()) == files(named.path()),
+        "generate differs from bare lfgen"
+    );
+    let one = tmp();
+    let said = stderr(&ok(generate(one.path(), "1", &[])));
+    assert!(said.contains("no val/ split"), "{said}");
+    assert!(!one.path().join("val").exists());
+}
+
+/// A ./generator.toml picked up from the working directory is announced; --no-config ignores
+/// it, and --config with --no-config is refused.
+#[test]
+fn an_implicit_generator_toml_is_announced_and_no_config_ignores_it() {
+    let d = tmp();
+    fs::write(d.path().join("generator.toml"), "[render]\nspp = 0\n").unwrap();
+    let run = |extra: &[&str]| {
+        let args = [
+            &["--scenes", "1", "--out", "ds", "--set", "render.sppp=1"],
+            extra,
+        ]
+        .concat();
+        Command::new(env!("CARGO_BIN_EXE_lfgen"))
+            .args(args)
+            .current_dir(d.path())
+            .output()
+            .unwrap()
+    };
+    let implicit = stderr(&run(&[]));
+    assert!(implicit.contains("using ./generator.toml"), "{implicit}");
+    assert!(implicit.contains("generator.toml"), "{implicit}");
+    let ignored = stderr(&run(&["--no-config"]));
+    assert!(!ignored.contains("generator.toml"), "{ignored}");
+    let both = run(&["--no-config", "--config", "x.toml"]);
+    assert!(!both.status.success() && stderr(&both).contains("--no-config"));
+}
+
+/// `lfgen --help` leads with `generate` and a one-line description per command; every help
+/// text is free of issue numbers; completions and the man page come from the same definitions.
+#[test]
+fn the_help_lists_commands_and_completions_and_man_page_are_generated() {
+    let help = String::from_utf8(ok(lfgen(&["--help"], &[])).stdout).unwrap();
+    let first = help
+        .lines()
+        .skip_while(|l| l != &"Commands:")
+        .nth(1)
+        .unwrap();
+    assert!(first.trim_start().starts_with("generate "), "{help}");
+    assert!(
+        !help.contains("--scenes <SCENES>"),
+        "generation flags belong to generate --help: {help}"
+    );
+    let all = String::from_utf8(ok(lfgen(&["doc", "cli"], &[])).stdout).unwrap();
+    let numbered = all
+        .char_indices()
+        .any(|(i, c)| c == '#' && all[i + 1..].starts_with(|d: char| d.is_ascii_digit()));
+    assert!(
+        !numbered && !all.contains("issue"),
+        "a help text names an issue"
+    );
+    let bash = String::from_utf8(ok(lfgen(&["completions", "bash"], &[])).stdout).unwrap();
+    assert!(bash.contains("quick wide clean") && bash.contains("pov blender mitsuba"));
+    let man = String::from_utf8(ok(lfgen(&["man"], &[])).stdout).unwrap();
+    assert!(man.contains(".TH lfgen 1"), "{man}");
 }

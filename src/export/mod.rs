@@ -17,23 +17,17 @@ use anyhow::{Context, Result};
 use extract::{ExportScene, ViewSelection};
 use std::path::Path;
 
-/// The renderers lfgen exports to.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// The renderers lfgen exports to (`lfgen export --to`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Target {
+    /// POV-Ray 3.7 scene files.
+    #[value(alias = "povray")]
     Pov,
-    Mitsuba,
+    /// Blender (Cycles): scene.py, which builds the scene and renders a view.
+    #[value(alias = "cycles")]
     Blender,
-}
-
-impl Target {
-    pub fn parse(s: &str) -> Result<Self> {
-        match s {
-            "pov" | "povray" => Ok(Self::Pov),
-            "mitsuba" => Ok(Self::Mitsuba),
-            "blender" | "cycles" => Ok(Self::Blender),
-            _ => anyhow::bail!("--to {s:?}: expected pov, blender or mitsuba"),
-        }
-    }
+    /// Mitsuba 3: scene.xml with one sensor per view.
+    Mitsuba,
 }
 
 /// Path limits in lfgen's terms (`render.max_depth` vertices, Russian roulette from vertex

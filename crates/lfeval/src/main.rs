@@ -4,7 +4,8 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use clap::{Args, Parser, Subcommand};
+use clap::builder::{PossibleValuesParser, TypedValueParser};
+use clap::{Args, CommandFactory, Parser, Subcommand};
 use lfeval::baseline::{BaselineConfig, DEFAULT_TEMPERATURE, DEFAULT_WINDOW};
 use lfeval::bins::Bins;
 use lfeval::metrics::kld::EPSILON;
@@ -40,6 +41,11 @@ enum Command {
     Baseline(BaselineArgs),
     /// Write the ground truth as a method's predictions (checks a pipeline: scores 0).
     Truth(TruthArgs),
+    /// Print a shell completion script, e.g. `lfeval completions bash > lfeval.bash`.
+    Completions { shell: clap_complete::Shell },
+    /// Print docs/reference/cli-lfeval.md, generated from the flag definitions.
+    #[command(hide = true)]
+    Doc,
 }
 
 /// Options every command shares.
@@ -151,8 +157,9 @@ struct BaselineArgs {
     common: Common,
     #[command(flatten)]
     bins: BinArgs,
-    /// Views entering the photo-consistency cost: cross, star or full.
-    #[arg(long, default_value = "cross")]
+    /// Views entering the photo-consistency cost.
+    #[arg(long, default_value = "cross",
+          value_parser = PossibleValuesParser::new(["cross", "star", "full"]).try_map(|s| s.parse::<ViewSet>()))]
     views: ViewSet,
     /// Softmax temperature, in units of the cost (colour variance, colours in [0, 1]).
     #[arg(long, default_value_t = DEFAULT_TEMPERATURE)]
@@ -208,6 +215,25 @@ fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Some(Command::Baseline(a)) => baseline(a),
         Some(Command::Truth(a)) => truth(a),
+        Some(Command::Completions { shell }) => {
+            let mut script = Vec::new();
+            clap_complete::generate(shell, &mut Cli::command(), "lfeval", &mut script);
+            let text = String::from_utf8_lossy(&script);
+            Ok(lfformat::console::stdout(format_args!("{text}"))?)
+        }
+        Some(Command::Doc) => {
+            let options = clap_markdown::MarkdownOptions::new()
+                .title("`lfeval` command-line reference".into())
+                .show_footer(false);
+            let md = clap_markdown::help_markdown_command_custom(&Cli::command(), &options);
+            let md = md.replacen(
+                "\n\n",
+                "\n\nGenerated from the flag definitions by `lfeval doc` (do not edit by hand: \
+                 run `lfeval doc > docs/reference/cli-lfeval.md`).\n\n",
+                1,
+            );
+            Ok(lfformat::console::stdout(format_args!("{md}"))?)
+        }
         None => evaluate(cli.eval),
     }
 }

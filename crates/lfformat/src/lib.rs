@@ -17,7 +17,9 @@ pub mod modes;
 pub mod mpi;
 pub mod params;
 pub mod pfm;
+pub mod png;
 pub mod read;
+pub mod results;
 pub mod views;
 
 pub use error::{Error, Result};

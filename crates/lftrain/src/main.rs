@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Result;
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, CommandFactory, Parser, Subcommand};
 use lftrain::config::{ModelKind, TrainConfig};
 use lftrain::loader::PoolConfig;
 use lftrain::predict::{Overrides, predict_dataset_over};
@@ -106,7 +106,15 @@ enum Command {
         /// Batches between two scene replacements (--loader).
         #[arg(long, default_value_t = 8)]
         pool_refresh: usize,
+        /// Results file the run appends its figures to, one JSON line (docs/reference/results.md).
+        #[arg(long, value_name = "FILE", default_value = lfformat::results::DEFAULT_PATH)]
+        results: PathBuf,
     },
+    /// Print a shell completion script, e.g. `lftrain completions bash > lftrain.bash`.
+    Completions { shell: clap_complete::Shell },
+    /// Print docs/reference/cli-lftrain.md, generated from the flag definitions.
+    #[command(hide = true)]
+    Doc,
 }
 
 #[derive(Args)]
@@ -199,6 +207,7 @@ fn run(cli: Cli) -> Result<()> {
             batches,
             scene_pool,
             pool_refresh,
+            results,
         } => {
             let mut cfg = match &config {
                 Some(path) => TrainConfig::read(path)?,
@@ -222,7 +231,16 @@ fn run(cli: Cli) -> Result<()> {
                     cfg.patch,
                     cfg.batch as f64 / crops
                 )?;
-                return Ok(());
+                let figures = serde_json::json!({
+                    "bench": "loader",
+                    "threads": rayon::current_num_threads(),
+                    "batch": cfg.batch,
+                    "patch": cfg.patch,
+                    "batches": batches,
+                    "first_batch_s": first,
+                    "crops_per_s": crops,
+                });
+                return record(figures, &results);
             }
             let (s, params) = bench_steps(&cfg, grid, steps)?;
             lfformat::say!(
@@ -235,6 +253,39 @@ fn run(cli: Cli) -> Result<()> {
                 lftrain::train::default_device(),
                 cfg.batch as f64 / s
             )?;
+            let figures = serde_json::json!({
+                "bench": "steps",
+                "model": cfg.model.name(),
+                "threads": rayon::current_num_threads(),
+                "device": format!("{:?}", lftrain::train::default_device()),
+                "parameters": params,
+                "batch": cfg.batch,
+                "patch": cfg.patch,
+                "grid": grid,
+                "steps": steps,
+                "seconds_per_step": s,
+                "samples_per_s": cfg.batch as f64 / s,
+            });
+            record(figures, &results)?;
+        }
+        Command::Completions { shell } => {
+            let mut script = Vec::new();
+            clap_complete::generate(shell, &mut Cli::command(), "lftrain", &mut script);
+            let text = String::from_utf8_lossy(&script);
+            lfformat::console::stdout(format_args!("{text}"))?;
+        }
+        Command::Doc => {
+            let options = clap_markdown::MarkdownOptions::new()
+                .title("`lftrain` command-line reference".into())
+                .show_footer(false);
+            let md = clap_markdown::help_markdown_command_custom(&Cli::command(), &options);
+            let md = md.replacen(
+                "\n\n",
+                "\n\nGenerated from the flag definitions by `lftrain doc` (do not edit by hand: \
+                 run `lftrain doc > docs/reference/cli-lftrain.md`).\n\n",
+                1,
+            );
+            lfformat::console::stdout(format_args!("{md}"))?;
         }
         Command::Predict {
             run,
@@ -255,6 +306,13 @@ fn run(cli: Cli) -> Result<()> {
             lfformat::note!("lftrain: {n} scenes written to {}", out.display());
         }
     }
+    Ok(())
+}
+
+/// Appends a benchmark's figures to the results file.
+fn record(figures: serde_json::Value, path: &std::path::Path) -> Result<()> {
+    lfformat::results::Record::now("lftrain", figures).append(path)?;
+    lfformat::note!("lftrain: figures appended to {}", path.display());
     Ok(())
 }
 
