@@ -28,4 +28,5 @@ pub mod dataset;
 pub mod export;
 pub mod output;
 pub mod pipeline;
+pub mod reference;
 pub mod stats;

@@ -37,7 +37,8 @@ const MAX_VALUES_PER_PIXEL: usize = 4096;
 impl NpzReader {
     /// Opens `path`.
     pub fn open(path: &Path) -> Result<Self> {
-        let archive = NpzArchive::open(path)
+        let file = BufReader::new(lfformat::read::open(path)?);
+        let archive = NpzArchive::new(file)
             .with_context(|| format!("{}: cannot open as .npz", path.display()))?;
         Ok(Self {
             path: path.to_path_buf(),

@@ -139,8 +139,7 @@ pub fn point_estimates(map: &PosteriorMap) -> FloatImage {
 
 /// Seconds from an HCI runtime file (one number, whitespace around it allowed).
 pub fn read_runtime(path: &Path) -> Result<f64> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("{}: cannot read", path.display()))?;
+    let text = lfformat::read::text(path)?;
     let value: f64 = text.trim().parse().with_context(|| {
         format!(
             "{}: expected one number of seconds, found {:?}",

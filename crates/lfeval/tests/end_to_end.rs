@@ -214,3 +214,103 @@ fn baseline_and_truth_are_evaluated_end_to_end() {
     let time = number(base, &["runtime_mean_s"]);
     assert!(time > 0.0 && time < 60.0, "runtime {time}");
 }
+
+#[test]
+fn a_fifo_or_dev_zero_in_a_dataset_is_refused_at_once() {
+    let tmp = tempfile::tempdir().unwrap();
+    let ds = tmp.path().join("dataset");
+    let scene = ds.join("scene_a");
+    write_scene(&scene, 1);
+    let view = scene.join("input_Cam040.png");
+    let out = tmp.path().join("truth");
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    for hostile in ["fifo", "zero"] {
+        std::fs::remove_file(&view).unwrap();
+        if hostile == "fifo" {
+            assert!(
+                Command::new("mkfifo")
+                    .arg(&view)
+                    .status()
+                    .unwrap()
+                    .success()
+            );
+        } else {
+            std::os::unix::fs::symlink("/dev/zero", &view).unwrap();
+        }
+        let r = Command::new("timeout")
+            .arg("20")
+            .arg(env!("CARGO_BIN_EXE_lfeval"))
+            .args(["baseline", &s(&ds), "--out", &s(&out), "--quiet"])
+            .output()
+            .expect("lfeval runs");
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.status.code(), Some(1), "{hostile}: {err}");
+        assert!(
+            err.contains("input_Cam040.png") && err.contains("not a regular file"),
+            "{hostile}: {err}"
+        );
+    }
+}
+
+/// `lfeval ARGS` under `strace`, its `n`-th `fsync` failing with ENOSPC (a full disk seen when
+/// the written bytes are flushed); `None` outside CI where strace cannot trace.
+fn lfeval_with_full_disk_at_sync(n: usize, args: &[&str]) -> Option<std::process::Output> {
+    let traces = Command::new("strace")
+        .args(["-qq", "-o", "/dev/null", "true"])
+        .status()
+        .is_ok_and(|s| s.success());
+    if !traces {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "strace is missing or cannot trace (.ci/run installs it)"
+        );
+        eprintln!("skipped: strace is missing or cannot trace here");
+        return None;
+    }
+    let out = Command::new("strace")
+        .args(["-f", "-qq", "-o", "/dev/null", "-e", "trace=fsync", "-e"])
+        .arg(format!("inject=fsync:error=ENOSPC:when={n}"))
+        .arg(env!("CARGO_BIN_EXE_lfeval"))
+        .args(args)
+        .output()
+        .expect("strace runs");
+    Some(out)
+}
+
+#[test]
+fn a_report_image_that_cannot_be_written_fails_the_run_and_leaves_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let root = tmp.path();
+    let ds = root.join("dataset");
+    write_scene(&ds.join("scene_a"), 1);
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let (truth, report) = (root.join("truth"), root.join("report"));
+    lfeval(&["truth", &s(&ds), "--out", &s(&truth), "--quiet"]);
+    let eval = [&s(&ds), &s(&truth), "--out", &s(&report), "--quiet"];
+    // The first file written is the error map; without them, the second (after
+    // metrics.json) is the first sparsification chart.
+    let cases = [
+        (1, "error_maps/truth/scene_a.png", &[][..]),
+        (2, "sparsification_badpix007.png", &["--no-error-maps"][..]),
+    ];
+    for (n, victim, extra) in cases {
+        let Some(out) = lfeval_with_full_disk_at_sync(n, &[&eval[..], extra].concat()) else {
+            return;
+        };
+        let err = String::from_utf8_lossy(&out.stderr);
+        let path = report.join(victim);
+        let name = path.file_name().unwrap().to_str().unwrap();
+        assert!(
+            out.status.code() == Some(1) && err.contains(name) && err.contains("No space left"),
+            "{victim}: {:?}: {err}",
+            out.status
+        );
+        let left: Vec<_> = std::fs::read_dir(path.parent().unwrap())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|f| f.starts_with(name))
+            .collect();
+        assert!(left.is_empty(), "{victim}: left behind {left:?}");
+        std::fs::remove_dir_all(&report).unwrap();
+    }
+}

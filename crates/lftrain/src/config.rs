@@ -649,8 +649,7 @@ pub const MAX_BATCH_PIXELS: usize = 1 << 24;
 impl TrainConfig {
     /// Reads a TOML file; missing fields keep their defaults, unknown ones are errors.
     pub fn read(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("{}: cannot read config", path.display()))?;
+        let text = lfformat::read::text(path)?;
         let cfg: Self =
             toml::from_str(&text).with_context(|| format!("{}: invalid config", path.display()))?;
         cfg.validate()

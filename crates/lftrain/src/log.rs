@@ -57,8 +57,7 @@ impl TrainLog {
         let mut records: Vec<Record> = Vec::new();
         let json = dir.join("log.json");
         if resume && json.exists() {
-            let text = std::fs::read_to_string(&json)
-                .with_context(|| format!("{}: cannot read", json.display()))?;
+            let text = lfformat::read::text(&json)?;
             records = serde_json::from_str(&text)
                 .with_context(|| format!("{}: invalid log", json.display()))?;
             records.retain(|r| r.step <= step);
@@ -94,7 +93,7 @@ impl TrainLog {
         self.csv.flush()?;
         let json = self.dir.join("log.json");
         let text = serde_json::to_string_pretty(&self.records)?;
-        std::fs::write(&json, text).with_context(|| format!("{}: cannot write", json.display()))?;
+        lfformat::files::write_atomic(&json, text.as_bytes())?;
         plot(&self.records, &self.dir.join("loss.png"))
     }
 }
@@ -146,8 +145,7 @@ pub fn plot(records: &[Record], path: &Path) -> Result<()> {
         root.present().map_err(plot_error)?;
     }
     let img = image::RgbImage::from_raw(w, h, buf).context("plot buffer size")?;
-    img.save(path)
-        .with_context(|| format!("{}: cannot write", path.display()))
+    Ok(lfformat::png::write_png(path, &img)?)
 }
 
 /// One line chart with its own axes.

@@ -76,8 +76,8 @@ fn render(
         draw(&root)?;
         root.present().map_err(plot_error)?;
     }
-    image::save_buffer(path, &buffer, w, h, image::ExtendedColorType::Rgb8)
-        .map_err(|e| anyhow!("{}: cannot write PNG: {e}", path.display()))
+    let img = image::RgbImage::from_raw(w, h, buffer).expect("the canvas is w × h RGB");
+    Ok(lfformat::png::write_png(path, &img)?)
 }
 
 /// Colour of method `i` (colour-blind-friendly Okabe–Ito order).

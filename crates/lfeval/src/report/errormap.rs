@@ -46,8 +46,7 @@ pub fn write(path: &Path, img: &RgbImage) -> Result<()> {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("{}: cannot create", dir.display()))?;
     }
-    img.save(path)
-        .with_context(|| format!("{}: cannot write PNG", path.display()))
+    Ok(lfformat::png::write_png(path, img)?)
 }
 
 /// Rec. 601 luma of interleaved RGB in `[0, 1]` (EPINET's grey conversion).

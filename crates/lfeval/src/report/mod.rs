@@ -74,7 +74,7 @@ pub fn posterior_plot_name(s: &PosteriorSample) -> String {
     format!("{}_x{}_y{}.png", s.scene, s.x, s.y)
 }
 
-/// Writes `text` to `path`, naming the file on failure.
+/// Writes `text` to `path` atomically, naming the file on failure.
 pub fn write_text(path: &Path, text: &str) -> Result<()> {
-    std::fs::write(path, text).with_context(|| format!("{}: cannot write", path.display()))
+    Ok(lfformat::files::write_atomic(path, text.as_bytes())?)
 }
