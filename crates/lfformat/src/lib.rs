@@ -17,6 +17,7 @@ pub mod modes;
 pub mod mpi;
 pub mod params;
 pub mod pfm;
+pub mod png;
 pub mod read;
 pub mod results;
 pub mod views;
