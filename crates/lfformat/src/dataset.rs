@@ -49,7 +49,7 @@ pub fn discover(root: &Path, splits: &[String]) -> Result<Vec<SceneDir>> {
         ));
     }
     check_unique(root, &scenes)?;
-    verify_against_manifest(root, &scenes)?;
+    verify_against_manifest(root, splits, &scenes)?;
     Ok(scenes)
 }
 
@@ -57,7 +57,7 @@ pub fn discover(root: &Path, splits: &[String]) -> Result<Vec<SceneDir>> {
 /// folders above it), every scene must be listed in it and its files must match their
 /// checksums: a damaged file, or a stray scene folder the manifest does not describe, is an
 /// error naming it instead of a silently wrong score.
-fn verify_against_manifest(root: &Path, scenes: &[SceneDir]) -> Result<()> {
+fn verify_against_manifest(root: &Path, splits: &[String], scenes: &[SceneDir]) -> Result<()> {
     let root = root.canonicalize().unwrap_or_else(|_| root.to_path_buf());
     let Some(dataset) = root
         .ancestors()
@@ -68,17 +68,13 @@ fn verify_against_manifest(root: &Path, scenes: &[SceneDir]) -> Result<()> {
     };
     let manifest_path = dataset.join("manifest.json");
     let manifest = Manifest::read(&manifest_path)?;
+    let mut found = Vec::with_capacity(scenes.len());
     for scene in scenes {
         let path = scene
             .path
             .canonicalize()
             .unwrap_or_else(|_| scene.path.clone());
-        let rel = path.strip_prefix(dataset).unwrap_or(&path);
-        let rel: Vec<String> = rel
-            .components()
-            .map(|c| c.as_os_str().to_string_lossy().into_owned())
-            .collect();
-        let rel = rel.join("/");
+        let rel = relative(&path, dataset);
         let entry = manifest
             .scenes
             .iter()
@@ -94,6 +90,69 @@ fn verify_against_manifest(root: &Path, scenes: &[SceneDir]) -> Result<()> {
                 )
             })?;
         verify_scene_entry(dataset, entry)?;
+        found.push(rel);
+    }
+    refuse_missing(
+        dataset,
+        &relative(&root, dataset),
+        splits,
+        &manifest,
+        &found,
+    )
+}
+
+/// `path` relative to `dataset`, `/`-separated (the form of the manifest's `dir`).
+fn relative(path: &Path, dataset: &Path) -> String {
+    let rel = path.strip_prefix(dataset).unwrap_or(path);
+    let parts: Vec<String> = rel
+        .components()
+        .map(|c| c.as_os_str().to_string_lossy().into_owned())
+        .collect();
+    parts.join("/")
+}
+
+/// A scene the manifest lists under `root` (`root_rel` from the dataset; in the selected
+/// `splits`) but whose folder or `parameters.cfg` is gone is an error naming it: scoring or
+/// training on fewer scenes than the dataset holds must not pass for a full run.
+fn refuse_missing(
+    dataset: &Path,
+    root_rel: &str,
+    splits: &[String],
+    manifest: &Manifest,
+    found: &[String],
+) -> Result<()> {
+    let prefix = if root_rel.is_empty() {
+        String::new()
+    } else {
+        format!("{root_rel}/")
+    };
+    for e in &manifest.scenes {
+        let Some(below) = e.dir.strip_prefix(&prefix) else {
+            continue;
+        };
+        let split = below.split('/').next().unwrap_or_default();
+        let selected = splits.is_empty() || splits.iter().any(|s| s == split);
+        if below.is_empty() || !selected || found.contains(&e.dir) {
+            continue;
+        }
+        let folder = dataset.join(&e.dir);
+        let (path, what) = if folder.is_dir() {
+            (
+                folder.join(PARAMETERS_FILE),
+                "its parameters.cfg is missing",
+            )
+        } else {
+            (folder, "its folder is missing")
+        };
+        return Err(Error::format(
+            &path,
+            format!(
+                "scene {} is listed in {} but {what}: restore it, or re-generate it with \
+                 lfgen --resume",
+                e.dir,
+                dataset.join("manifest.json").display()
+            ),
+        ));
     }
     Ok(())
 }

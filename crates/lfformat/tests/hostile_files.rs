@@ -103,3 +103,35 @@ fn a_file_longer_than_the_manifest_records_is_refused() {
     let e = refused_quickly(move || discover(&root, &[]));
     assert!(e.contains(GT) && e.contains("more than the 7 bytes"), "{e}");
 }
+
+#[test]
+fn a_listed_scene_whose_folder_or_parameters_are_gone_is_an_error_naming_it() {
+    let d = tempfile::tempdir().unwrap();
+    let root = d.path();
+    dataset(root);
+    let path = root.join("manifest.json");
+    let mut manifest = Manifest::read(&path).unwrap();
+    let mut gone = manifest.scenes[0].clone();
+    gone.index = 1;
+    gone.dir = "val/scene_0001".into();
+    manifest.scenes.push(gone);
+    manifest.write(&path).unwrap();
+    for dir in [root.to_path_buf(), root.join("val")] {
+        let e = discover(&dir, &[]).unwrap_err().to_string();
+        assert!(
+            e.contains("val/scene_0001") && e.contains("its folder is missing"),
+            "{e}"
+        );
+    }
+    std::fs::create_dir(root.join("val/scene_0001")).unwrap();
+    let e = discover(root, &["val".into()]).unwrap_err().to_string();
+    assert!(
+        e.contains("scene_0001/parameters.cfg") && e.contains("its parameters.cfg is missing"),
+        "{e}"
+    );
+    // The scene that is there may still be read on its own.
+    assert_eq!(
+        discover(&root.join("val/scene_0000"), &[]).unwrap().len(),
+        1
+    );
+}
