@@ -451,8 +451,8 @@ fn next_steps(cfg: &Config, opts: &GenerateOptions) -> String {
     }
     text += &format!(
         "\nnext, train a model and evaluate it beside the classical baseline:\n  \
-         lftrain train --train {out}/train --val {out}/val \
-         --config crates/lftrain/configs/quickstart.toml --out runs/quickstart\n  \
+         lftrain train --model base --config crates/lftrain/configs/quickstart.toml \
+         --train {out}/train --val {out}/val --out runs/quickstart\n  \
          lftrain predict runs/quickstart {out}/val --out predictions/model\n  \
          lfeval baseline {out}/val --out predictions/baseline\n  \
          lfeval {out}/val predictions/model predictions/baseline --out report"

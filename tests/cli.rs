@@ -506,7 +506,11 @@ fn small_datasets_get_a_val_split_and_the_run_names_the_next_commands() {
     let val = format!("{}/val", whole.path().display());
     assert!(said.contains("1 scenes in train/, 1 in val/"), "{said}");
     assert!(
-        said.contains("lftrain train --train") && said.contains(&val),
+        said.contains("lftrain train --model base")
+            && said.contains(&format!(
+                "--train {}/train --val {val}",
+                whole.path().display()
+            )),
         "{said}"
     );
     assert!(said.contains(&format!("lfeval baseline {val}")), "{said}");
