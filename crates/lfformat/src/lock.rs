@@ -12,7 +12,7 @@
 //! names the file it locked, and starts over otherwise.
 
 use std::fs::{File, OpenOptions, TryLockError};
-use std::io::{ErrorKind, Read, Write};
+use std::io::{ErrorKind, Read, Seek, Write};
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
@@ -30,6 +30,14 @@ impl Lock {
     /// holds it.
     pub fn exclusive(path: &Path) -> Result<Self> {
         let mut lock = Self::take(path, true)?;
+        if !is_lock_file(&mut lock.file) {
+            lock.exclusive = false; // not ours to remove on drop
+            return Err(Error::format(
+                path,
+                "holds something other than an lfgen lock; lfgen needs this name for its \
+                 lock file: move or rename it",
+            ));
+        }
         let holder = format!("pid {} ({})\n", std::process::id(), command_line());
         lock.file.set_len(0).map_err(|e| Error::io(path, e))?;
         lock.file
@@ -91,6 +99,15 @@ impl Drop for Lock {
             let _ = std::fs::remove_file(&self.path);
         }
     }
+}
+
+/// Whether `file` is empty or holds a holder line: a file of the user's that happens to have
+/// the lock's name is neither, and is never truncated or removed.
+fn is_lock_file(file: &mut File) -> bool {
+    let mut start = [0u8; 4];
+    let n = file.read(&mut start).unwrap_or(usize::MAX);
+    let rewound = file.rewind().is_ok();
+    rewound && (n == 0 || (n == 4 && &start == b"pid "))
 }
 
 /// The error for a lock someone else holds, naming them when the file says who.
@@ -162,6 +179,29 @@ mod tests {
         drop((a, b));
         assert!(path.exists(), "shared holders leave the file");
         let _x = Lock::exclusive(&path).unwrap();
+    }
+
+    #[test]
+    fn a_file_of_the_lock_name_that_is_no_lock_is_kept() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join(".out.lock");
+        std::fs::write(&path, "my notes").unwrap();
+        let e = Lock::exclusive(&path).unwrap_err().to_string();
+        assert!(
+            e.contains(".out.lock") && e.contains("move or rename"),
+            "{e}"
+        );
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "my notes");
+        // A lock file left by a killed holder is taken over, its holder line replaced.
+        std::fs::write(&path, "pid 1 (lfgen)\n").unwrap();
+        let taken = Lock::exclusive(&path).unwrap();
+        let holder = std::fs::read_to_string(&path).unwrap();
+        assert!(
+            holder.starts_with(&format!("pid {} (", std::process::id())),
+            "{holder:?}"
+        );
+        drop(taken);
+        assert!(!path.exists());
     }
 
     #[test]
