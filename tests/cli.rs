@@ -372,7 +372,8 @@ fn preview_sheets_summary_and_texture_library() {
     assert_eq!(summary["scenes"], 2);
     assert!(summary["objects_placed"].as_u64().unwrap() > 0);
     ok(lfgen(&["preview", d.path().to_str().unwrap()], &[]));
-    for name in ["train_scene_0000.png", "train_scene_0001.png", "index.html"] {
+    // Two scenes: the first trains, the last is the small dataset's val scene.
+    for name in ["train_scene_0000.png", "val_scene_0001.png", "index.html"] {
         assert!(d.path().join("previews").join(name).is_file(), "{name}");
     }
     let t = tmp();
@@ -403,7 +404,9 @@ fn rays_through_windows_and_doors_end_on_a_surface() {
     ok(generate(&out, "3", &extra));
     let mut seen = [false; 2];
     for i in 0..3 {
-        let scene = out.join(format!("train/scene_{i:04}"));
+        // Three scenes: the last is the small dataset's val scene.
+        let split = if i == 2 { "val" } else { "train" };
+        let scene = out.join(format!("{split}/scene_{i:04}"));
         let json = fs::read_to_string(scene.join("scene.json")).unwrap();
         // Not every wanted opening fits a narrow room; each scene gets some.
         let kinds = ["outside_sky", "outside_corridor"].map(|k| json.contains(k));
