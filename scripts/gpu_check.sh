@@ -7,7 +7,7 @@
 # Needs an lftrain built with `cargo build --release -p lftrain --features wgpu` (BIN) and a
 # Vulkan driver; scripts/gpu_carry.py packs binary and data for a device machine. CFG and
 # STEPS override the config and the 200 steps (a CPU dry run: BURN_DEVICE=flex, a small CFG).
-# Writes OUT_DIR/{log.txt,runs/,pred/}; crates/lftrain/README.md, "GPU training", has the rest.
+# Writes OUT_DIR/{log.txt,runs/,pred/}; docs/design/training-models.md, "GPU training", has the rest.
 # Use: DATA=datasets/lfgen BIN=target/release/lftrain OUT_DIR=gpu BUDGET=470 scripts/gpu_check.sh
 set -uo pipefail
 : "${DATA:?DATA must name a dataset root with train/ and val/}"

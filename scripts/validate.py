@@ -295,7 +295,7 @@ def cmd_timed(a):
 def psnr(ref, img):
     """PSNR of linear `img` against `ref`, both scaled by the reference's automatic exposure
     (key 0.18 on the log-average luminance, as lfgen's `auto_exposure`), peak 1: the figure
-    `lfgen bench --quality` calls linear PSNR."""
+    `lfgen bench quality` calls linear PSNR."""
     lum = ref @ np.array([0.2126, 0.7152, 0.0722])
     k = 0.18 / np.exp(np.mean(np.log(lum + 1e-4)))
     return -10 * np.log10(np.mean(((img - ref) * k) ** 2))

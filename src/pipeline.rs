@@ -128,9 +128,9 @@ impl RenderJob {
     /// gathers [`CELL_FILL`] fill samples (`fill_spp × views` per pixel footprint). A fill
     /// sample costs about five camera samples (a full path against one cache lookup), so at
     /// the defaults one per view and cells √(256 / 81) ≈ 1.8 pixel footprints wide are the
-    /// cheaper way to a quiet cache: on `lfgen bench --quality` (128², 3 Dec 2026) they gave
-    /// the views of 4 fill samples and 1-pixel cells within −0.5…+0.3 dB (8-bit), and a
-    /// full-size scene in 0.69× the time, with 20 spp for 16 (crates/lfrender/README.md). The
+    /// cheaper way to a quiet cache: on `lfgen bench quality` (128²) they gave the views of
+    /// 4 fill samples and 1-pixel cells within −0.5…+0.3 dB (8-bit), and a full-size scene in
+    /// 0.69× the time, with 20 spp for 16 (results/measurements.jsonl). The
     /// wider cell blurs the lighting over more of a pixel footprint; where the fill is dense
     /// (validate.sh's single view at 1024 spp) the configured cell stays.
     pub fn cache_params(&self, views: u32) -> CacheParams {

@@ -38,7 +38,7 @@ pub struct RenderSettings {
 ///
 /// Why: a view's own noise (what shared shading cannot share: the pixel-area integral over
 /// edges and fine texture, glass, mirrors and narrow glossy lobes) sits in few pixels — at
-/// 128² the noisiest 5 % hold about 80 % of it (`lfgen bench --quality`) — so spending samples
+/// 128² the noisiest 5 % hold about 80 % of it (`lfgen bench quality`) — so spending samples
 /// there buys more PSNR than raising `spp` everywhere. The test is Cycles' adaptive-sampling
 /// error, the standard error of the pixel mean summed over RGB divided by the square root of
 /// its summed brightness (a rough perceptual weight), in display units.
@@ -48,7 +48,7 @@ pub struct RenderSettings {
 /// where light arrives by rare paths, by at most the share `extra / (spp + extra)` of the
 /// selected pixels' first-pass excess. It vanishes as the threshold goes to zero (every pixel
 /// gets `spp + extra` samples) and is measured against the converged independent render in
-/// crates/lfrender/README.md.
+/// docs/design/shared-shading.md.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Adaptive {
     /// Extra camera samples of a noisy pixel (0: off).
