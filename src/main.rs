@@ -4,6 +4,7 @@
 use anyhow::{Context, Result, bail};
 use clap::builder::{PossibleValue, PossibleValuesParser};
 use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand};
+use lfformat::cli::{Generated, Workers};
 use lfgen::config::{Config, PRESETS};
 use lfgen::dataset::{self, GenerateOptions};
 use lfgen::export::Target;
@@ -68,10 +69,8 @@ enum Command {
         #[command(subcommand)]
         kind: BenchKind,
     },
-    /// Print a shell completion script, e.g. `lfgen completions bash > lfgen.bash`.
-    Completions { shell: clap_complete::Shell },
-    /// Print the man page (roff), e.g. `lfgen man > lfgen.1`.
-    Man,
+    #[command(flatten)]
+    Generated(Generated),
     /// Print a generated reference page of docs/reference/.
     #[command(hide = true)]
     Doc { page: DocPage },
@@ -127,12 +126,8 @@ struct ConfigArgs {
     /// Override any config key, e.g. --set camera.resolution=[64,64] (repeatable).
     #[arg(long = "set", value_name = "SECTION.KEY=VALUE")]
     sets: Vec<String>,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    threads: Option<usize>,
-    /// No progress bar.
-    #[arg(long, short)]
-    quiet: bool,
+    #[command(flatten)]
+    workers: Workers,
 }
 
 /// The presets the config knows, with their one-line descriptions, for parsing, `--help` and
@@ -268,7 +263,8 @@ fn run(cli: Cli) -> Result<()> {
         Command::Render(a) => {
             let cfg = load(&a.common)?;
             let camera = a.camera.as_deref();
-            lfgen::pipeline::render_file(&cfg, &a.scene, camera, &a.out, a.common.quiet)
+            let quiet = a.common.workers.quiet;
+            lfgen::pipeline::render_file(&cfg, &a.scene, camera, &a.out, quiet)
         }
         Command::Textures { count, out, seed } => {
             let cat = lfgen::output::texture_library::write_library(&out, count, seed)?;
@@ -315,42 +311,24 @@ fn run(cli: Cli) -> Result<()> {
             };
             lfgen::export::export_scene_dir(&a.scene_dir, a.to, &a.out, &views, limits)
         }
-        Command::Completions { shell } => {
-            let mut script = Vec::new();
-            clap_complete::generate(shell, &mut command(), "lfgen", &mut script);
-            print_bytes(&script)
-        }
-        Command::Man => {
-            let mut page = Vec::new();
-            clap_mangen::Man::new(command()).render(&mut page)?;
-            print_bytes(&page)
-        }
+        Command::Generated(g) => Ok(g.print(command())?),
         Command::Doc { page } => {
             let text = match page {
                 DocPage::Cli => cli_markdown(),
                 DocPage::Config => lfgen::reference::config_markdown(),
             };
-            print_bytes(text.as_bytes())
+            lfformat::console::stdout(format_args!("{text}"))?;
+            Ok(())
         }
     }
 }
 
-/// Writes generated text to standard output (an error if it cannot be written).
-fn print_bytes(bytes: &[u8]) -> Result<()> {
-    lfformat::console::stdout(format_args!("{}", String::from_utf8_lossy(bytes)))?;
-    Ok(())
-}
-
 /// docs/reference/cli.md: every command and flag, from the definitions above.
 fn cli_markdown() -> String {
-    let options = clap_markdown::MarkdownOptions::new()
-        .title("`lfgen` command-line reference".into())
-        .show_footer(false);
     let generated = "Generated from the flag definitions by `lfgen doc cli` (do not edit by \
                      hand: run `lfgen doc cli > docs/reference/cli.md`). `lftrain` and \
                      `lfeval`: [cli-lftrain.md](cli-lftrain.md), [cli-lfeval.md](cli-lfeval.md).";
-    let md = clap_markdown::help_markdown_command_custom(&command(), &options);
-    md.replacen("\n\n", &format!("\n\n{generated}\n\n"), 1)
+    lfformat::cli::reference(&command(), generated)
 }
 
 /// Runs a benchmark and appends its record to the results file.
@@ -374,15 +352,7 @@ fn bench(kind: BenchKind) -> Result<()> {
 /// Loads the config and sets up the thread pool. An implicit ./generator.toml is announced, so
 /// a file left in the working directory never changes a run unnoticed.
 fn load(a: &ConfigArgs) -> Result<Config> {
-    if let Some(n) = a.threads {
-        if n == 0 || n > MAX_THREADS {
-            bail!("--threads {n}: expected 1 to {MAX_THREADS}");
-        }
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build_global()
-            .context("cannot set --threads")?;
-    }
+    a.workers.apply().context("cannot set --threads")?;
     let default = Path::new("generator.toml");
     let path = match (&a.config, a.no_config) {
         (Some(path), _) => Some(path.as_path()),
@@ -397,9 +367,6 @@ fn load(a: &ConfigArgs) -> Result<Config> {
     };
     Config::load(path, &a.preset, &a.sets)
 }
-
-/// More worker threads than this only cost memory (each keeps per-pixel buffers).
-const MAX_THREADS: usize = 1024;
 
 /// Scene folders are numbered with four or more digits; ten million scenes is far beyond any
 /// dataset and keeps the progress arithmetic in range.
@@ -423,7 +390,7 @@ fn generate(a: GenerateArgs) -> Result<()> {
         out: a.out.unwrap_or_else(|| PathBuf::from(&cfg.dataset.out)),
         shard,
         resume: a.resume,
-        quiet: a.common.quiet,
+        quiet: a.common.workers.quiet,
         strict: a.strict,
     };
     dataset::generate(&cfg, &opts)?;

@@ -40,7 +40,7 @@ fn a_run_with_full_stdout_and_stderr_writes_the_same_dataset_and_exits_0() {
 
 #[test]
 fn an_error_with_a_full_stderr_still_exits_1() {
-    let run = lfgen_into_full_disk(&["--threads", "0"], true);
+    let run = lfgen_into_full_disk(&["--shard", "9/2"], true);
     assert_eq!(run.status.code(), Some(1));
 }
 

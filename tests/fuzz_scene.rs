@@ -10,6 +10,7 @@ mod bin;
 mod mutate;
 mod skip;
 
+use bin::{can_bound, run_bounded};
 use lfgen::config::Config;
 use lfgen::render::RenderScene;
 use lfgen::render::integrator::PathSettings;
@@ -17,7 +18,7 @@ use lfgen::render::slices::SliceAssignment;
 use lfgen::render::view::{Adaptive, RenderSettings};
 use lfgen::scene::SceneDesc;
 use lfgen::scene::assets::Assets;
-use mutate::{can_bound, mutate, run_bounded};
+use mutate::mutate;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 use serde_json::Value;
@@ -141,7 +142,7 @@ fn thousands_of_mutated_scene_files_are_refused_or_rendered_never_a_panic() {
 #[test]
 fn mutated_scene_files_through_the_binary_exit_0_or_1_within_bounds() {
     if !can_bound() {
-        skip::skip("prlimit is missing (apt-get install util-linux; .ci/run installs it)");
+        skip::skip(bin::NO_PRLIMIT);
         return;
     }
     let dir = tempfile::tempdir().unwrap();
@@ -223,16 +224,17 @@ fn hostile_config_values_are_refused_with_the_key_named() {
             "{set}: a refused run left files"
         );
     }
-    for (args, needle) in [
-        (&["--scenes", "18446744073709551615"][..], "--scenes"),
-        (&["--threads", "100000"][..], "--threads"),
+    // A value outside --threads' range is a usage error (exit 2), refused while parsing.
+    for (args, needle, code) in [
+        (&["--scenes", "18446744073709551615"][..], "--scenes", 1),
+        (&["--threads", "100000"][..], "--threads <N>", 2),
     ] {
         let d = tempfile::tempdir().unwrap();
         let mut all = args.to_vec();
         all.extend(["--out", d.path().to_str().unwrap(), "--quiet"]);
         let r = bin::lfgen(&all);
         assert!(
-            r.status.code() == Some(1) && bin::stderr(&r).contains(needle),
+            r.status.code() == Some(code) && bin::stderr(&r).contains(needle),
             "{args:?}: {}",
             bin::stderr(&r)
         );

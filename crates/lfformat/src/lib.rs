@@ -7,6 +7,7 @@
 //! that contributes to a pixel, and `manifest.json` ties a dataset's scenes together.
 
 pub mod catalog;
+pub mod cli;
 pub mod console;
 pub mod dataset;
 pub mod error;

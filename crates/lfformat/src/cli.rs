@@ -1,0 +1,156 @@
+//! What the command lines of `lfgen`, `lftrain` and `lfeval` share, defined once so that a
+//! flag means the same and reads the same in all three: the worker threads and quiet flags,
+//! and the shell completions, man page and Markdown reference each binary generates from its
+//! own flag definitions.
+
+use std::path::Path;
+
+use clap::builder::RangedU64ValueParser;
+
+/// More worker threads than this only cost memory (each keeps per-pixel buffers).
+pub const MAX_THREADS: usize = 1024;
+
+/// `--threads` and `-q`, flattened into every command that does parallel work.
+#[derive(clap::Args, Debug, Clone, Copy, Default)]
+pub struct Workers {
+    /// Worker threads (default: all cores).
+    #[arg(long, value_name = "N", value_parser = threads())]
+    pub threads: Option<usize>,
+    /// No progress bar or progress messages (results, warnings and errors still print).
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// `--threads`' values: 1 to [`MAX_THREADS`], checked while parsing, so a bad value is a usage
+/// error naming the flag and the range before any work starts.
+fn threads() -> RangedU64ValueParser<usize> {
+    RangedU64ValueParser::new().range(1..=MAX_THREADS as u64)
+}
+
+impl Workers {
+    /// Sizes rayon's global thread pool by `--threads`; call once, before any parallel work.
+    pub fn apply(&self) -> Result<(), rayon::ThreadPoolBuildError> {
+        match self.threads {
+            Some(n) => rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build_global(),
+            None => Ok(()),
+        }
+    }
+
+    /// Makes `--threads` and `-q` global in `cmd`, for a binary whose top level holds them
+    /// (`Workers` flattened there): they may then come before or after a command name.
+    pub fn global(cmd: clap::Command) -> clap::Command {
+        cmd.mut_arg("threads", |a| a.global(true))
+            .mut_arg("quiet", |a| a.global(true))
+    }
+}
+
+/// The commands every binary offers for its shell and its manual.
+#[derive(clap::Subcommand, Debug, Clone, Copy)]
+pub enum Generated {
+    /// Print the shell completion script for SHELL, to save where the shell loads completions.
+    Completions {
+        /// Shell to complete in.
+        shell: clap_complete::Shell,
+    },
+    /// Print the man page (roff), to pipe into `man -l -` or save in a man directory.
+    Man,
+}
+
+impl Generated {
+    /// Writes the completion script or man page of `cmd` (the binary's whole command line)
+    /// to standard output.
+    pub fn print(self, mut cmd: clap::Command) -> crate::Result<()> {
+        let mut bytes = Vec::new();
+        match self {
+            Self::Completions { shell } => {
+                let name = cmd.get_name().to_string();
+                clap_complete::generate(shell, &mut cmd, name, &mut bytes);
+            }
+            Self::Man => clap_mangen::Man::new(cmd)
+                .render(&mut bytes)
+                .map_err(|e| crate::Error::io(Path::new("man page"), e))?,
+        }
+        crate::console::stdout(format_args!("{}", String::from_utf8_lossy(&bytes)))
+    }
+}
+
+/// The Markdown reference of every command and flag of `cmd`, under the title "`NAME`
+/// command-line reference", with `note` (how the page is generated) as its first paragraph.
+pub fn reference(cmd: &clap::Command, note: &str) -> String {
+    let options = clap_markdown::MarkdownOptions::new()
+        .title(format!("`{}` command-line reference", cmd.get_name()))
+        .show_footer(false);
+    let md = clap_markdown::help_markdown_command_custom(cmd, &options);
+    md.replacen("\n\n", &format!("\n\n{note}\n\n"), 1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
+
+    #[derive(Parser, Debug)]
+    #[command(name = "bin")]
+    struct Cli {
+        #[command(subcommand)]
+        command: Command,
+        #[command(flatten)]
+        workers: Workers,
+    }
+
+    #[derive(Subcommand, Debug)]
+    enum Command {
+        Run,
+        #[command(flatten)]
+        Generated(Generated),
+    }
+
+    fn parse(args: &[&str]) -> Result<Cli, clap::Error> {
+        let matches = Workers::global(Cli::command()).try_get_matches_from(args)?;
+        Cli::from_arg_matches(&matches)
+    }
+
+    #[test]
+    fn threads_takes_1_to_1024_and_refuses_the_rest_naming_the_flag_and_range() {
+        for (n, expected) in [("1", 1), ("1024", MAX_THREADS)] {
+            let cli = parse(&["bin", "--threads", n, "run"]).unwrap();
+            assert_eq!(cli.workers.threads, Some(expected));
+        }
+        for bad in ["0", "1025", "-1", "many"] {
+            let e = parse(&["bin", &format!("--threads={bad}"), "run"]).unwrap_err();
+            assert_eq!(e.exit_code(), 2, "{bad}");
+            assert!(e.to_string().contains("--threads <N>"), "{bad}: {e}");
+        }
+        let e = parse(&["bin", "--threads", "0", "run"]).unwrap_err();
+        assert!(e.to_string().contains("1..=1024"), "{e}");
+    }
+
+    #[test]
+    fn global_workers_are_read_before_or_after_the_command_name() {
+        for args in [
+            &["bin", "-q", "--threads", "3", "run"][..],
+            &["bin", "run", "--threads", "3", "--quiet"][..],
+        ] {
+            let cli = parse(args).unwrap();
+            assert!(
+                cli.workers.quiet && cli.workers.threads == Some(3),
+                "{args:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_reference_is_titled_by_the_binary_and_opens_with_the_note() {
+        let page = reference(&Cli::command(), "Generated by a test.");
+        assert!(
+            page.starts_with("# `bin` command-line reference\n\nGenerated by a test.\n\n"),
+            "{page}"
+        );
+        assert!(
+            page.contains("--threads <N>") && page.contains("## `bin man`"),
+            "{page}"
+        );
+    }
+}
