@@ -4,7 +4,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Result;
-use clap::{Args, CommandFactory, Parser, Subcommand};
+use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand};
+use lfformat::cli::{Generated, Workers};
 use lftrain::config::{ModelKind, TrainConfig};
 use lftrain::loader::PoolConfig;
 use lftrain::predict::{Overrides, predict_dataset_over};
@@ -40,12 +41,13 @@ fn keep_freed_pages() {
 struct Cli {
     #[command(subcommand)]
     command: Command,
-    /// Worker threads (default: all cores).
-    #[arg(long, global = true)]
-    threads: Option<usize>,
-    /// No progress bar.
-    #[arg(short, long, global = true)]
-    quiet: bool,
+    #[command(flatten)]
+    workers: Workers,
+}
+
+/// The command line, with `--threads` and `-q` accepted before or after the command name.
+fn command() -> clap::Command {
+    Workers::global(Cli::command())
 }
 
 #[derive(Subcommand)]
@@ -56,9 +58,9 @@ enum Command {
     Predict {
         /// Run folder of `lftrain train`.
         run: PathBuf,
-        /// Dataset (root with split folders, split folder, or scene folder).
+        /// Dataset root, split folder or scene folder.
         dataset: PathBuf,
-        /// Output folder (one lfeval method).
+        /// Prediction folder to write (one method for lfeval).
         #[arg(long)]
         out: PathBuf,
         /// Disparity range MIN,MAX the shifts cover (epishift: default each scene's
@@ -82,36 +84,36 @@ enum Command {
     /// Seconds per training step of a configuration on random input (no data loading), or
     /// with --loader the crops/s of the data loader alone.
     Bench {
-        /// TOML config (network, batch, patch, model).
+        /// Training config file (TOML; keys left out keep their defaults).
         #[arg(long)]
         config: Option<PathBuf>,
         /// Model; overrides the config file.
         #[arg(long, value_enum)]
         model: Option<ModelKind>,
-        /// Views per grid side.
-        #[arg(long, default_value_t = 9)]
+        /// Views per grid side (not with --loader).
+        #[arg(long, default_value_t = 9, conflicts_with = "loader")]
         grid: usize,
-        /// Timed steps (after one warm-up step).
-        #[arg(long, default_value_t = 5)]
+        /// Timed steps, after one warm-up step (not with --loader).
+        #[arg(long, default_value_t = 5, conflicts_with = "loader")]
         steps: usize,
         /// Time the data loader alone on this dataset instead (crops/s, no training).
-        #[arg(long)]
+        #[arg(long, value_name = "DATASET")]
         loader: Option<PathBuf>,
-        /// Timed batches of --loader (after the first).
-        #[arg(long, default_value_t = 50)]
+        /// Timed batches of --loader, after the first.
+        #[arg(long, default_value_t = 50, requires = "loader")]
         batches: usize,
-        /// Scenes held in memory by the loader (--loader).
-        #[arg(long, default_value_t = 16)]
+        /// Scenes held in memory by --loader.
+        #[arg(long, default_value_t = 16, requires = "loader")]
         scene_pool: usize,
-        /// Batches between two scene replacements (--loader).
-        #[arg(long, default_value_t = 8)]
+        /// Batches between two scene replacements of --loader.
+        #[arg(long, default_value_t = 8, requires = "loader")]
         pool_refresh: usize,
         /// Results file the run appends its figures to, one JSON line (docs/reference/results.md).
         #[arg(long, value_name = "FILE", default_value = lfformat::results::DEFAULT_PATH)]
         results: PathBuf,
     },
-    /// Print a shell completion script, e.g. `lftrain completions bash > lftrain.bash`.
-    Completions { shell: clap_complete::Shell },
+    #[command(flatten)]
+    Generated(Generated),
     /// Print docs/reference/cli-lftrain.md, generated from the flag definitions.
     #[command(hide = true)]
     Doc,
@@ -125,16 +127,16 @@ struct TrainCmd {
     /// Train on all modes weighted by η (lfgen datasets) instead of the front-most one.
     #[arg(long)]
     multimodal: bool,
-    /// Training dataset.
+    /// Training dataset: root, split folder or scene folder.
     #[arg(long)]
     train: PathBuf,
     /// Validation dataset (validated every `val_every` steps through lfeval's metrics).
     #[arg(long)]
     val: Option<PathBuf>,
-    /// Run folder.
+    /// Run folder to write (with --resume: to continue).
     #[arg(long)]
     out: PathBuf,
-    /// TOML config (see README); fields left out keep their defaults.
+    /// Training config file (TOML; keys left out keep their defaults).
     #[arg(long)]
     config: Option<PathBuf>,
     /// Continue the run in --out from its checkpoint (its stored config is used).
@@ -153,22 +155,18 @@ struct TrainCmd {
 
 fn main() -> ExitCode {
     keep_freed_pages();
-    let cli = Cli::parse();
+    let cli = Cli::from_arg_matches(&command().get_matches()).unwrap_or_else(|e| e.exit());
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            lfformat::note!("lftrain: {e:#}");
+            lfformat::note!("error: {e:#}");
             ExitCode::FAILURE
         }
     }
 }
 
 fn run(cli: Cli) -> Result<()> {
-    if let Some(n) = cli.threads {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build_global()?;
-    }
+    cli.workers.apply()?;
     match cli.command {
         Command::Train(t) => {
             let mut cfg = match &t.config {
@@ -184,7 +182,7 @@ fn run(cli: Cli) -> Result<()> {
                 val: t.val,
                 out: t.out,
                 resume: t.resume,
-                quiet: cli.quiet,
+                quiet: cli.workers.quiet,
                 pool: PoolConfig {
                     scenes: t.scene_pool,
                     refresh: t.pool_refresh,
@@ -268,23 +266,11 @@ fn run(cli: Cli) -> Result<()> {
             });
             record(figures, &results)?;
         }
-        Command::Completions { shell } => {
-            let mut script = Vec::new();
-            clap_complete::generate(shell, &mut Cli::command(), "lftrain", &mut script);
-            let text = String::from_utf8_lossy(&script);
-            lfformat::console::stdout(format_args!("{text}"))?;
-        }
+        Command::Generated(g) => g.print(command())?,
         Command::Doc => {
-            let options = clap_markdown::MarkdownOptions::new()
-                .title("`lftrain` command-line reference".into())
-                .show_footer(false);
-            let md = clap_markdown::help_markdown_command_custom(&Cli::command(), &options);
-            let md = md.replacen(
-                "\n\n",
-                "\n\nGenerated from the flag definitions by `lftrain doc` (do not edit by hand: \
-                 run `lftrain doc > docs/reference/cli-lftrain.md`).\n\n",
-                1,
-            );
+            let note = "Generated from the flag definitions by `lftrain doc` (do not edit by \
+                        hand: run `lftrain doc > docs/reference/cli-lftrain.md`).";
+            let md = lfformat::cli::reference(&command(), note);
             lfformat::console::stdout(format_args!("{md}"))?;
         }
         Command::Predict {
@@ -302,7 +288,7 @@ fn run(cli: Cli) -> Result<()> {
                 rotations,
                 mode_window,
             };
-            let n = predict_dataset_over(&run, &dataset, &out, cli.quiet, &overrides)?;
+            let n = predict_dataset_over(&run, &dataset, &out, cli.workers.quiet, &overrides)?;
             lfformat::note!("lftrain: {n} scenes written to {}", out.display());
         }
     }
