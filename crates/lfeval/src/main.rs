@@ -1,11 +1,12 @@
 //! `lfeval`: evaluate light-field depth predictions, or produce baseline / ground-truth
 //! predictions to evaluate. See the crate README for formats and metric definitions.
 
+use std::ffi::OsString;
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::builder::{PossibleValuesParser, TypedValueParser};
-use clap::{Args, CommandFactory, Parser, Subcommand};
+use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 use lfeval::baseline::{BaselineConfig, DEFAULT_TEMPERATURE, DEFAULT_WINDOW};
 use lfeval::bins::Bins;
 use lfeval::metrics::kld::EPSILON;
@@ -14,6 +15,7 @@ use lfeval::prediction::Method;
 use lfeval::report::{self, samples::PixelRequest};
 use lfeval::scene_eval::EvalConfig;
 use lfeval::truth::{EtaKind, Reference};
+use lfformat::cli::{Generated, Workers};
 use lfformat::dataset::{PARAMETERS_FILE, SceneDir, discover};
 use lfformat::views::ViewSet;
 
@@ -33,6 +35,47 @@ struct Cli {
     command: Option<Command>,
     #[command(flatten)]
     eval: EvalArgs,
+    #[command(flatten)]
+    workers: Workers,
+}
+
+/// The command line, with `--threads` and `-q` accepted before or after the command name.
+fn command() -> clap::Command {
+    Workers::global(Cli::command())
+}
+
+/// `args` as clap should read them: global options written before a command name
+/// (`lfeval -q baseline DATASET`) moved after it.
+///
+/// lfeval's top level takes the evaluation's own arguments as well as commands, and once it
+/// has read an option there, clap takes every further word for an evaluation argument: the
+/// DATASET `baseline`. The moved options are global, so after the name they mean the same.
+fn globals_after_command(cmd: &clap::Command, mut args: Vec<OsString>) -> Vec<OsString> {
+    // Whether `word` is a global option, and if so whether the next word is its value.
+    let global = |word: &str| {
+        let (name, inline_value) = word
+            .split_once('=')
+            .map_or((word, false), |(n, _)| (n, true));
+        cmd.get_arguments()
+            .filter(|a| a.is_global_set())
+            .find_map(|a| {
+                let long = a
+                    .get_long()
+                    .is_some_and(|l| name.strip_prefix("--") == Some(l));
+                let short = a.get_short().is_some_and(|c| word == format!("-{c}"));
+                (long || short).then(|| a.get_action().takes_values() && !inline_value)
+            })
+    };
+    let word = |i: usize| args.get(i).and_then(|w| w.to_str());
+    let mut i = 1;
+    while let Some(takes_value) = word(i).and_then(global) {
+        i += 1 + usize::from(takes_value);
+    }
+    if i > 1 && word(i).is_some_and(|w| cmd.find_subcommand(w).is_some()) {
+        let name = args.remove(i);
+        args.insert(1, name);
+    }
+    args
 }
 
 #[derive(Subcommand)]
@@ -41,25 +84,19 @@ enum Command {
     Baseline(BaselineArgs),
     /// Write the ground truth as a method's predictions (checks a pipeline: scores 0).
     Truth(TruthArgs),
-    /// Print a shell completion script, e.g. `lfeval completions bash > lfeval.bash`.
-    Completions { shell: clap_complete::Shell },
+    #[command(flatten)]
+    Generated(Generated),
     /// Print docs/reference/cli-lfeval.md, generated from the flag definitions.
     #[command(hide = true)]
     Doc,
 }
 
-/// Options every command shares.
+/// Options every command that reads a dataset shares.
 #[derive(Args)]
 struct Common {
     /// Only these split folders of DATASET (repeatable), e.g. --split val.
     #[arg(long = "split", value_name = "NAME")]
     splits: Vec<String>,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    threads: Option<usize>,
-    /// No progress bar.
-    #[arg(short, long)]
-    quiet: bool,
 }
 
 /// The disparity bins.
@@ -113,7 +150,7 @@ struct EvalArgs {
     /// Prediction folders, one per method (named by the folder).
     #[arg(required = true)]
     predictions: Vec<PathBuf>,
-    /// Report folder.
+    /// Report folder to write.
     #[arg(long, default_value = "lfeval_report")]
     out: PathBuf,
     #[command(flatten)]
@@ -205,53 +242,37 @@ fn parse_range(s: &str) -> Result<RangeArg, String> {
 }
 
 fn main() {
-    if let Err(e) = run(Cli::parse()) {
+    let cmd = command();
+    let args = globals_after_command(&cmd, std::env::args_os().collect());
+    let cli = Cli::from_arg_matches(&cmd.get_matches_from(args)).unwrap_or_else(|e| e.exit());
+    if let Err(e) = run(cli) {
         lfformat::note!("error: {e:#}");
         std::process::exit(1);
     }
 }
 
 fn run(cli: Cli) -> Result<()> {
+    cli.workers
+        .apply()
+        .context("cannot set up the worker threads")?;
+    let quiet = cli.workers.quiet;
     match cli.command {
-        Some(Command::Baseline(a)) => baseline(a),
-        Some(Command::Truth(a)) => truth(a),
-        Some(Command::Completions { shell }) => {
-            let mut script = Vec::new();
-            clap_complete::generate(shell, &mut Cli::command(), "lfeval", &mut script);
-            let text = String::from_utf8_lossy(&script);
-            Ok(lfformat::console::stdout(format_args!("{text}"))?)
-        }
+        Some(Command::Baseline(a)) => baseline(a, quiet),
+        Some(Command::Truth(a)) => truth(a, quiet),
+        Some(Command::Generated(g)) => Ok(g.print(command())?),
         Some(Command::Doc) => {
-            let options = clap_markdown::MarkdownOptions::new()
-                .title("`lfeval` command-line reference".into())
-                .show_footer(false);
-            let md = clap_markdown::help_markdown_command_custom(&Cli::command(), &options);
-            let md = md.replacen(
-                "\n\n",
-                "\n\nGenerated from the flag definitions by `lfeval doc` (do not edit by hand: \
-                 run `lfeval doc > docs/reference/cli-lfeval.md`).\n\n",
-                1,
-            );
+            let note = "Generated from the flag definitions by `lfeval doc` (do not edit by \
+                        hand: run `lfeval doc > docs/reference/cli-lfeval.md`).";
+            let md = lfformat::cli::reference(&command(), note);
             Ok(lfformat::console::stdout(format_args!("{md}"))?)
         }
-        None => evaluate(cli.eval),
+        None => evaluate(cli.eval, quiet),
     }
 }
 
-/// Applies `--threads` and finds the scenes.
-fn setup(dataset: &std::path::Path, common: &Common) -> Result<Vec<SceneDir>> {
-    if let Some(n) = common.threads {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build_global()
-            .context("cannot set up the worker threads")?;
-    }
-    Ok(discover(dataset, &common.splits)?)
-}
-
-fn evaluate(a: EvalArgs) -> Result<()> {
+fn evaluate(a: EvalArgs, quiet: bool) -> Result<()> {
     let dataset = a.dataset.expect("clap requires DATASET");
-    let scenes = setup(&dataset, &a.common)?;
+    let scenes = discover(&dataset, &a.common.splits)?;
     let methods = a
         .predictions
         .iter()
@@ -273,22 +294,20 @@ fn evaluate(a: EvalArgs) -> Result<()> {
         pixels: a.pixels,
         auto_plot_scenes: a.plot_scenes,
         error_maps: !a.no_error_maps,
-        quiet: a.common.quiet,
+        quiet,
     };
     std::fs::create_dir_all(&a.out)
         .with_context(|| format!("{}: cannot create", a.out.display()))?;
     let eval = pipeline::evaluate_dataset(&dataset, scenes, methods, &opts)?;
     report::write_all(&eval, &a.out)?;
-    if !a.common.quiet {
-        let table = report::table::main_table(&eval).to_markdown();
-        lfformat::console::stdout(format_args!("{table}"))?;
-        lfformat::note!("report written to {}", a.out.join("report.html").display());
-    }
+    let table = report::table::main_table(&eval).to_markdown();
+    lfformat::console::stdout(format_args!("{table}"))?;
+    lfformat::note!("report written to {}", a.out.join("report.html").display());
     Ok(())
 }
 
-fn baseline(a: BaselineArgs) -> Result<()> {
-    let scenes = setup(&a.dataset, &a.common)?;
+fn baseline(a: BaselineArgs, quiet: bool) -> Result<()> {
+    let scenes = discover(&a.dataset, &a.common.splits)?;
     if !(a.temperature.is_finite() && a.temperature > 0.0) {
         anyhow::bail!("--temperature must be positive, got {}", a.temperature);
     }
@@ -298,18 +317,11 @@ fn baseline(a: BaselineArgs) -> Result<()> {
         temperature: a.temperature,
         window: a.window,
     };
-    pipeline::baseline_dataset(
-        &a.dataset,
-        &scenes,
-        &a.out,
-        &cfg,
-        !a.no_posterior,
-        a.common.quiet,
-    )
+    pipeline::baseline_dataset(&a.dataset, &scenes, &a.out, &cfg, !a.no_posterior, quiet)
 }
 
-fn truth(a: TruthArgs) -> Result<()> {
-    let scenes = setup(&a.dataset, &a.common)?;
+fn truth(a: TruthArgs, quiet: bool) -> Result<()> {
+    let scenes = discover(&a.dataset, &a.common.splits)?;
     let settings = (a.reference, a.eta, a.bins.bins(&scenes)?);
-    pipeline::truth_dataset(&a.dataset, &scenes, &a.out, settings, a.common.quiet)
+    pipeline::truth_dataset(&a.dataset, &scenes, &a.out, settings, quiet)
 }
