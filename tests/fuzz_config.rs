@@ -7,12 +7,14 @@
 //! per-case watchdog; a sample also runs through the `lfgen` binary under a time and
 //! address-space limit, where an abort or a hang would show as a signal or a time-out.
 
+mod bin;
 mod mutate;
 mod skip;
 
+use bin::{can_bound, run_bounded};
 use lfgen::config::Config;
 use lfgen::pipeline::{RenderJob, generate_scene};
-use mutate::{can_bound, mutate, run_bounded};
+use mutate::mutate;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 use serde_json::Value;
@@ -169,7 +171,7 @@ fn thousands_of_mutated_configs_are_refused_or_rendered_never_a_panic_or_a_hang(
 #[test]
 fn mutated_configs_through_the_binary_exit_0_or_1_within_bounds() {
     if !can_bound() {
-        skip::skip("prlimit is missing (apt-get install util-linux; .ci/run installs it)");
+        skip::skip(bin::NO_PRLIMIT);
         return;
     }
     let dir = tempfile::tempdir().unwrap();

@@ -6,6 +6,7 @@
 //! `ulimit -v` or a cluster's memory limit would hold it.
 
 mod bin;
+mod skip;
 
 use lfgen::config::Config;
 use lfgen::procgen::library::AssetLibrary;
@@ -15,7 +16,6 @@ use lfgen::scene::texture_image::{DecodeBudgets, TextureImage};
 use serde_json::{Value, json};
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 /// Four corners of a unit square, two texture coordinates and a normal, then `faces`.
 fn square_obj(faces: &str) -> String {
@@ -254,20 +254,10 @@ fn plane(dir: &Path) -> Value {
     serde_json::from_str(&fs::read_to_string(fixture("plane.gltf")).unwrap()).unwrap()
 }
 
-/// Whether `prlimit` (util-linux) is here to bound the binary runs.
-fn can_bound() -> bool {
-    Command::new("prlimit").arg("--version").output().is_ok()
-}
-
-/// `lfgen args` under a 4 GiB address space, 60 s of CPU and 120 s of wall time: exit 1 with
-/// one error naming every one of `needles`, no panic, no abort, no time-out.
+/// `lfgen args` under the 4 GiB bound of [`bin::bounded`]: exit 1 with one error naming every
+/// one of `needles`, no panic, no abort, no time-out.
 fn refused_within_4_gib(args: &[&str], needles: &[&str]) {
-    let r = Command::new("timeout")
-        .args(["120", "prlimit", "--as=4294967296", "--cpu=60"])
-        .arg(env!("CARGO_BIN_EXE_lfgen"))
-        .args(args)
-        .output()
-        .unwrap();
+    let r = bin::bounded(args);
     let err = bin::stderr(&r);
     assert!(
         r.status.code() == Some(1)
@@ -284,9 +274,8 @@ fn refused_within_4_gib(args: &[&str], needles: &[&str]) {
 /// limit — not a panic inside the decoder.
 #[test]
 fn eight_16k_textures_are_refused_before_they_exhaust_memory() {
-    if !can_bound() {
-        eprintln!("skipped: prlimit (util-linux) is missing");
-        return;
+    if !bin::can_bound() {
+        return skip::skip(bin::NO_PRLIMIT);
     }
     let dir = tempfile::tempdir().unwrap();
     let mut json = plane(dir.path());
@@ -373,9 +362,8 @@ fn scene_file(dir: &Path, name: &str, change: impl Fn(&mut Value)) -> PathBuf {
 /// is the same resolution in the config.
 #[test]
 fn views_and_shapes_that_cannot_fit_are_refused_by_their_estimate() {
-    if !can_bound() {
-        eprintln!("skipped: prlimit (util-linux) is missing");
-        return;
+    if !bin::can_bound() {
+        return skip::skip(bin::NO_PRLIMIT);
     }
     let dir = tempfile::tempdir().unwrap();
     let views = scene_file(dir.path(), "views.json", |v| {
@@ -426,9 +414,8 @@ fn views_and_shapes_that_cannot_fit_are_refused_by_their_estimate() {
 /// estimate refuses it before the count of 20 M triangles would).
 #[test]
 fn gltf_triangles_are_counted_from_the_accessors_before_they_are_read() {
-    if !can_bound() {
-        eprintln!("skipped: prlimit (util-linux) is missing");
-        return;
+    if !bin::can_bound() {
+        return skip::skip(bin::NO_PRLIMIT);
     }
     let dir = tempfile::tempdir().unwrap();
     let mut json = plane(dir.path());

@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 use std::collections::BTreeMap;
+use std::ffi::OsStr;
 use std::fs;
 use std::path::Path;
 use std::process::{Command, Output};
@@ -84,4 +85,47 @@ pub fn generate(out: &Path, scenes: &str, extra: &[&str]) -> Output {
     args.extend_from_slice(extra);
     args.extend_from_slice(TINY);
     lfgen(&args)
+}
+
+/// Why a bounded test cannot run when [`can_bound`] is false.
+pub const NO_PRLIMIT: &str = "prlimit is missing (apt-get install util-linux; .ci/run installs it)";
+
+/// Whether `prlimit` (util-linux) is here to bound the binary runs.
+pub fn can_bound() -> bool {
+    Command::new("prlimit").arg("--version").output().is_ok()
+}
+
+/// Runs `lfgen args` under a 4 GiB address space (as a user's `ulimit -v` or a cluster's
+/// memory limit would hold it), 60 s of CPU and 120 s of wall time, from the temporary folder:
+/// away from the repository's generator.toml, which lfgen would announce and apply. Paths in
+/// `args` must be absolute.
+pub fn bounded<S: AsRef<OsStr>>(args: &[S]) -> Output {
+    Command::new("timeout")
+        .args(["120", "prlimit", "--as=4294967296", "--cpu=60"])
+        .arg(env!("CARGO_BIN_EXE_lfgen"))
+        .args(args)
+        .current_dir(std::env::temp_dir())
+        .output()
+        .expect("timeout and prlimit run")
+}
+
+/// [`bounded`], asserting it ended with exit code 0 or 1 (not a signal, abort or time-out),
+/// a refusal with one `error:` cause and no panic. `what` is shown on failure. Returns the
+/// exit code.
+pub fn run_bounded<S: AsRef<OsStr>>(args: &[S], what: &str) -> i32 {
+    let r = bounded(args);
+    let err = stderr(&r);
+    let code = r.status.code();
+    assert!(
+        matches!(code, Some(0 | 1)),
+        "ended with {:?}: {err}\n{what}",
+        r.status
+    );
+    if code == Some(1) {
+        assert!(
+            err.starts_with("error: ") && !err.contains("panicked"),
+            "{err}\n{what}"
+        );
+    }
+    code.unwrap()
 }
