@@ -247,7 +247,9 @@ fn command() -> clap::Command {
 }
 
 fn main() {
-    let cli = Cli::from_arg_matches(&command().get_matches()).unwrap_or_else(|e| e.exit());
+    let cmd = command();
+    let args = lfformat::cli::options_after_command(&cmd, std::env::args_os().collect());
+    let cli = Cli::from_arg_matches(&cmd.get_matches_from(args)).unwrap_or_else(|e| e.exit());
     if let Err(e) = run(cli) {
         lfformat::note!("error: {e:#}");
         std::process::exit(1);

@@ -595,3 +595,27 @@ fn the_help_lists_commands_and_completions_and_man_page_are_generated() {
     let man = String::from_utf8(ok(lfgen(&["man"], &[])).stdout).unwrap();
     assert!(man.contains(".TH lfgen 1"), "{man}");
 }
+
+/// An option written before a command name that the command takes applies to it, as lftrain's
+/// and lfeval's do; one the command does not take is refused, naming both.
+#[test]
+fn options_before_a_command_name_apply_to_the_command() {
+    let missing = "/nonexistent/lfgen-cli-test.gltf";
+    for args in [
+        &["-q", "--threads", "1", "render", missing, "--out", "o"][..],
+        &["render", missing, "--out", "o", "-q", "--threads", "1"],
+    ] {
+        let r = lfgen(args, &[]);
+        assert!(
+            r.status.code() == Some(1) && stderr(&r).contains(missing),
+            "{args:?}: {}",
+            stderr(&r)
+        );
+    }
+    let r = lfgen(&["-q", "merge", "d"], &[]);
+    assert!(
+        r.status.code() == Some(2) && stderr(&r).contains("'merge' cannot be used with '--quiet'"),
+        "{}",
+        stderr(&r)
+    );
+}

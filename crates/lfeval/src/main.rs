@@ -1,7 +1,6 @@
 //! `lfeval`: evaluate light-field depth predictions, or produce baseline / ground-truth
 //! predictions to evaluate. See the crate README for formats and metric definitions.
 
-use std::ffi::OsString;
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
@@ -42,40 +41,6 @@ struct Cli {
 /// The command line, with `--threads` and `-q` accepted before or after the command name.
 fn command() -> clap::Command {
     Workers::global(Cli::command())
-}
-
-/// `args` as clap should read them: global options written before a command name
-/// (`lfeval -q baseline DATASET`) moved after it.
-///
-/// lfeval's top level takes the evaluation's own arguments as well as commands, and once it
-/// has read an option there, clap takes every further word for an evaluation argument: the
-/// DATASET `baseline`. The moved options are global, so after the name they mean the same.
-fn globals_after_command(cmd: &clap::Command, mut args: Vec<OsString>) -> Vec<OsString> {
-    // Whether `word` is a global option, and if so whether the next word is its value.
-    let global = |word: &str| {
-        let (name, inline_value) = word
-            .split_once('=')
-            .map_or((word, false), |(n, _)| (n, true));
-        cmd.get_arguments()
-            .filter(|a| a.is_global_set())
-            .find_map(|a| {
-                let long = a
-                    .get_long()
-                    .is_some_and(|l| name.strip_prefix("--") == Some(l));
-                let short = a.get_short().is_some_and(|c| word == format!("-{c}"));
-                (long || short).then(|| a.get_action().takes_values() && !inline_value)
-            })
-    };
-    let word = |i: usize| args.get(i).and_then(|w| w.to_str());
-    let mut i = 1;
-    while let Some(takes_value) = word(i).and_then(global) {
-        i += 1 + usize::from(takes_value);
-    }
-    if i > 1 && word(i).is_some_and(|w| cmd.find_subcommand(w).is_some()) {
-        let name = args.remove(i);
-        args.insert(1, name);
-    }
-    args
 }
 
 #[derive(Subcommand)]
@@ -243,7 +208,7 @@ fn parse_range(s: &str) -> Result<RangeArg, String> {
 
 fn main() {
     let cmd = command();
-    let args = globals_after_command(&cmd, std::env::args_os().collect());
+    let args = lfformat::cli::options_after_command(&cmd, std::env::args_os().collect());
     let cli = Cli::from_arg_matches(&cmd.get_matches_from(args)).unwrap_or_else(|e| e.exit());
     if let Err(e) = run(cli) {
         lfformat::note!("error: {e:#}");

@@ -3,6 +3,7 @@
 //! and the shell completions, man page and Markdown reference each binary generates from its
 //! own flag definitions.
 
+use std::ffi::OsString;
 use std::path::Path;
 
 use clap::builder::RangedU64ValueParser;
@@ -44,6 +45,53 @@ impl Workers {
         cmd.mut_arg("threads", |a| a.global(true))
             .mut_arg("quiet", |a| a.global(true))
     }
+}
+
+/// `args` (the whole command line, program name first) as clap should read them, for a
+/// binary whose top level takes arguments of its own beside its commands (bare `lfgen`
+/// generates, bare `lfeval DATASET PRED...` evaluates).
+///
+/// Once clap has read an option at such a top level it reads every further word as a
+/// top-level argument, never as a command name: `lfeval -q baseline DIR` would evaluate a
+/// dataset named `baseline`. Options written before a command name that the command takes
+/// too (its own or global ones) are therefore moved after the name, where they mean the same.
+/// Anything else is left for clap to read, or refuse, as written; `--` still makes the next
+/// word an argument.
+pub fn options_after_command(cmd: &clap::Command, mut args: Vec<OsString>) -> Vec<OsString> {
+    let word = |i: usize| args.get(i).and_then(|w| w.to_str());
+    let mut options = Vec::new();
+    let mut i = 1;
+    while let Some((arg, takes_value)) = word(i).and_then(|w| top_level_option(cmd, w)) {
+        options.push(arg);
+        i += 1 + usize::from(takes_value);
+    }
+    let taken = word(i)
+        .and_then(|w| cmd.find_subcommand(w))
+        .is_some_and(|sub| {
+            options
+                .iter()
+                .all(|a| a.is_global_set() || sub.get_arguments().any(|b| b.get_id() == a.get_id()))
+        });
+    if !options.is_empty() && taken {
+        let name = args.remove(i);
+        args.insert(1, name);
+    }
+    args
+}
+
+/// The top-level option `word` names (`--name`, `--name=value` or `-c`), and whether the
+/// next word is its value.
+fn top_level_option<'a>(cmd: &'a clap::Command, word: &str) -> Option<(&'a clap::Arg, bool)> {
+    let (name, inline_value) = word
+        .split_once('=')
+        .map_or((word, false), |(n, _)| (n, true));
+    let arg = cmd.get_arguments().find(|a| {
+        let long = a
+            .get_long()
+            .is_some_and(|l| name.strip_prefix("--") == Some(l));
+        long || a.get_short().is_some_and(|c| word == format!("-{c}"))
+    })?;
+    Some((arg, arg.get_action().takes_values() && !inline_value))
 }
 
 /// The commands every binary offers for its shell and its manual.
@@ -91,25 +139,36 @@ mod tests {
     use super::*;
     use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
+    /// A binary shaped like lfeval: a top level with arguments of its own beside commands.
     #[derive(Parser, Debug)]
-    #[command(name = "bin")]
+    #[command(name = "bin", args_conflicts_with_subcommands = true)]
     struct Cli {
         #[command(subcommand)]
-        command: Command,
+        command: Option<Command>,
+        dataset: Option<String>,
+        #[arg(long)]
+        split: Option<String>,
+        #[arg(long)]
+        border: Option<u32>,
         #[command(flatten)]
         workers: Workers,
     }
 
     #[derive(Subcommand, Debug)]
     enum Command {
-        Run,
+        Run {
+            dataset: Option<String>,
+            #[arg(long)]
+            split: Option<String>,
+        },
         #[command(flatten)]
         Generated(Generated),
     }
 
     fn parse(args: &[&str]) -> Result<Cli, clap::Error> {
-        let matches = Workers::global(Cli::command()).try_get_matches_from(args)?;
-        Cli::from_arg_matches(&matches)
+        let cmd = Workers::global(Cli::command());
+        let args = options_after_command(&cmd, args.iter().map(OsString::from).collect());
+        Cli::from_arg_matches(&cmd.try_get_matches_from(args)?)
     }
 
     #[test]
@@ -128,17 +187,60 @@ mod tests {
     }
 
     #[test]
-    fn global_workers_are_read_before_or_after_the_command_name() {
+    fn options_the_command_takes_are_read_before_or_after_its_name() {
         for args in [
-            &["bin", "-q", "--threads", "3", "run"][..],
-            &["bin", "run", "--threads", "3", "--quiet"][..],
+            &["bin", "-q", "--threads", "3", "--split=val", "run", "d"][..],
+            &[
+                "bin",
+                "--split",
+                "val",
+                "--threads=3",
+                "--quiet",
+                "run",
+                "d",
+            ],
+            &[
+                "bin",
+                "run",
+                "d",
+                "--threads",
+                "3",
+                "--quiet",
+                "--split",
+                "val",
+            ],
+        ] {
+            let cli = parse(args).unwrap();
+            let Some(Command::Run { dataset, split }) = &cli.command else {
+                panic!("{args:?}: {cli:?}");
+            };
+            assert!(
+                cli.workers.quiet
+                    && cli.workers.threads == Some(3)
+                    && dataset.as_deref() == Some("d")
+                    && split.as_deref() == Some("val"),
+                "{args:?}: {cli:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn other_words_are_read_as_written() {
+        // The top level's own arguments; after `--`, a command name is one of them.
+        for (args, dataset) in [
+            (&["bin", "-q", "d"][..], "d"),
+            (&["bin", "-q", "--", "run"], "run"),
+            (&["bin", "--border", "3", "--", "run"], "run"),
         ] {
             let cli = parse(args).unwrap();
             assert!(
-                cli.workers.quiet && cli.workers.threads == Some(3),
-                "{args:?}"
+                cli.command.is_none() && cli.dataset.as_deref() == Some(dataset),
+                "{args:?}: {cli:?}"
             );
         }
+        // An option the command does not take stays where it was: clap refuses it there.
+        let e = parse(&["bin", "--border", "3", "run", "d"]).unwrap_err();
+        assert_eq!(e.exit_code(), 2, "{e}");
     }
 
     #[test]
