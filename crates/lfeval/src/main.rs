@@ -198,12 +198,8 @@ fn parse_range(s: &str) -> Result<RangeArg, String> {
     if s.trim() == "auto" {
         return Ok(RangeArg::Auto);
     }
-    let bad = || format!("expected MIN,MAX such as -3.5,3.5 or auto, got {s:?}");
-    let (a, b) = s.split_once(',').ok_or_else(bad)?;
-    Ok(RangeArg::Fixed(
-        a.trim().parse().map_err(|_| bad())?,
-        b.trim().parse().map_err(|_| bad())?,
-    ))
+    let [min, max] = lfformat::cli::parse_range(s, "-3.5,3.5 or auto")?;
+    Ok(RangeArg::Fixed(min, max))
 }
 
 fn main() {

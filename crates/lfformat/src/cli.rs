@@ -94,6 +94,19 @@ fn top_level_option<'a>(cmd: &'a clap::Command, word: &str) -> Option<(&'a clap:
     Some((arg, arg.get_action().takes_values() && !inline_value))
 }
 
+/// A disparity range `MIN,MAX` in pixels, finite with MIN ≤ MAX, as `--range` takes it in
+/// `lftrain predict` and `lfeval`; the error shows `example` and what was given.
+pub fn parse_range(s: &str, example: &str) -> Result<[f64; 2], String> {
+    let bad = || format!("expected MIN,MAX (finite, MIN ≤ MAX) such as {example}, got {s:?}");
+    let (lo, hi) = s.split_once(',').ok_or_else(bad)?;
+    let num = |v: &str| v.trim().parse::<f64>().map_err(|_| bad());
+    let r = [num(lo)?, num(hi)?];
+    if !(r[0].is_finite() && r[1].is_finite() && r[0] <= r[1]) {
+        return Err(bad());
+    }
+    Ok(r)
+}
+
 /// The commands every binary offers for its shell and its manual.
 #[derive(clap::Subcommand, Debug, Clone, Copy)]
 pub enum Generated {
@@ -169,6 +182,19 @@ mod tests {
         let cmd = Workers::global(Cli::command());
         let args = options_after_command(&cmd, args.iter().map(OsString::from).collect());
         Cli::from_arg_matches(&cmd.try_get_matches_from(args)?)
+    }
+
+    #[test]
+    fn a_range_is_two_finite_numbers_in_order() {
+        assert_eq!(parse_range("-3.5, 3.5", "-1,1"), Ok([-3.5, 3.5]));
+        assert_eq!(parse_range("2,2", "-1,1"), Ok([2.0, 2.0]));
+        for bad in ["3,-3", "nan,1", "1,inf", "1", "a,b", ""] {
+            let e = parse_range(bad, "-1,1").unwrap_err();
+            assert!(
+                e.contains("such as -1,1") && e.contains(&format!("{bad:?}")),
+                "{e}"
+            );
+        }
     }
 
     #[test]

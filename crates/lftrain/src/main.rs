@@ -304,14 +304,11 @@ fn record(figures: serde_json::Value, path: &std::path::Path) -> Result<()> {
 
 /// `MIN,MAX` in pixels, MIN ≤ MAX.
 fn parse_range(s: &str) -> std::result::Result<[f32; 2], String> {
-    let bad = || format!("expected MIN,MAX such as -40,40, got {s:?}");
-    let (lo, hi) = s.split_once(',').ok_or_else(bad)?;
-    let num = |v: &str| v.trim().parse::<f32>().map_err(|_| bad());
-    let r = [num(lo)?, num(hi)?];
-    if !(r[0].is_finite() && r[1].is_finite() && r[0] <= r[1]) {
-        return Err(bad());
+    let r = lfformat::cli::parse_range(s, "-40,40")?.map(|v| v as f32);
+    match r.iter().all(|v| v.is_finite()) {
+        true => Ok(r),
+        false => Err(format!("{s:?} is beyond single precision")),
     }
-    Ok(r)
 }
 
 #[cfg(test)]
