@@ -77,6 +77,14 @@ pub fn default_device() -> Device {
 /// Trains `cfg` (ignored on `--resume`, where the run's stored config is used; only
 /// `args.steps` applies then).
 pub fn train(mut cfg: TrainConfig, args: &TrainArgs) -> Result<TrainSummary> {
+    // The datasets are found and read before the run folder is made, so a wrong path leaves
+    // nothing behind.
+    let train_scenes = discover(&args.train, &[])?;
+    let grid = grid_of(&train_scenes)?;
+    let val = match &args.val {
+        Some(v) => load_scenes(&discover(v, &[])?)?,
+        None => Vec::new(),
+    };
     let run = RunDir::new(&args.out);
     let (cfg, state) = if args.resume {
         let mut stored = run.config()?;
@@ -100,12 +108,6 @@ pub fn train(mut cfg: TrainConfig, args: &TrainArgs) -> Result<TrainSummary> {
             .with_context(|| format!("{}: cannot create", args.out.display()))?;
         cfg.write(&args.out.join(CONFIG_FILE))?;
         (cfg, RunState::default())
-    };
-    let train_scenes = discover(&args.train, &[])?;
-    let grid = grid_of(&train_scenes)?;
-    let val = match &args.val {
-        Some(v) => load_scenes(&discover(v, &[])?)?,
-        None => Vec::new(),
     };
     let base = default_device();
     if !args.quiet {

@@ -106,3 +106,14 @@ fn man_page_and_completions_come_from_the_flag_definitions() {
         "{script}"
     );
 }
+
+/// A training run whose dataset is not there fails before it makes its run folder: no empty
+/// `runs/…` is left behind to be mistaken for a run.
+#[test]
+fn a_run_on_a_missing_dataset_leaves_no_run_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("runs/r");
+    let out_arg = out.to_str().unwrap();
+    reads_the_missing_path(&["train", "--train", MISSING, "--out", out_arg]);
+    assert!(!dir.path().join("runs").exists());
+}
