@@ -17,6 +17,7 @@ use lfgen::scene::shapes::tessellate;
 use lfgen::scene::texture_image::{DecodeBudgets, srgb_to_linear};
 use lfgen::scene::{Opacity, Shape, Texture};
 use std::path::{Path, PathBuf};
+use std::process::Command;
 
 fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/assets")
@@ -309,4 +310,37 @@ fn the_cli_warns_once_per_skipped_entry_renders_and_rerenders_the_scene() {
             "{f} re-rendered from scene.json"
         );
     }
+}
+
+/// A catalogue named by a bare file name, from its own folder (`--set
+/// scene.catalog=catalog.json`), has its entries resolved against the working folder instead of
+/// failing every one of them with "cannot resolve : No such file or directory".
+#[test]
+fn a_catalogue_named_relative_to_the_working_folder_is_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("ds");
+    let r = Command::new(env!("CARGO_BIN_EXE_lfgen"))
+        .current_dir(fixtures())
+        .args([
+            "--no-config",
+            "--scenes",
+            "1",
+            "--out",
+            out.to_str().unwrap(),
+            "--quiet",
+        ])
+        .args([
+            "--set",
+            "scene.catalog=catalog.json",
+            "--set",
+            "camera.resolution=[16,12]",
+        ])
+        .args(["--set", "camera.grid=[1,1]", "--set", "render.spp=1"])
+        .output()
+        .unwrap();
+    let err = stderr(&r);
+    assert!(
+        r.status.success() && err.contains("4 assets usable, 9 skipped"),
+        "{err}"
+    );
 }

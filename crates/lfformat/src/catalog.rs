@@ -167,7 +167,12 @@ impl LoadedCatalog {
                 ),
             ));
         }
-        let dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+        // A bare file name's parent is "", which names no folder: it is the working folder.
+        let dir = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        }
+        .to_path_buf();
         Ok(Self {
             path: path.to_path_buf(),
             dir,
