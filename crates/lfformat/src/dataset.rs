@@ -59,10 +59,13 @@ pub fn discover(root: &Path, splits: &[String]) -> Result<Vec<SceneDir>> {
 /// error naming it instead of a silently wrong score.
 fn verify_against_manifest(root: &Path, splits: &[String], scenes: &[SceneDir]) -> Result<()> {
     let root = root.canonicalize().unwrap_or_else(|_| root.to_path_buf());
+    // Any entry of that name counts, so that one which is no regular file (a FIFO, a link to
+    // /dev/zero) is refused naming it by the reader instead of passing for "no manifest" and
+    // skipping every checksum.
     let Some(dataset) = root
         .ancestors()
         .take(3)
-        .find(|d| d.join("manifest.json").is_file())
+        .find(|d| d.join("manifest.json").symlink_metadata().is_ok())
     else {
         return Ok(());
     };
@@ -349,5 +352,20 @@ mod tests {
         make_scene(&r.join("val/scene_0001"));
         let e = format!("{:#}", discover(r, &[]).unwrap_err());
         assert!(e.contains("scene_0001") && e.contains("not listed"), "{e}");
+    }
+
+    /// A manifest.json that is a link to /dev/zero is refused naming it, not taken for an
+    /// absent manifest (which would skip every checksum).
+    #[cfg(unix)]
+    #[test]
+    fn a_manifest_that_is_no_regular_file_is_refused() {
+        let d = tempfile::tempdir().unwrap();
+        make_scene(&d.path().join("val/scene_0000"));
+        std::os::unix::fs::symlink("/dev/zero", d.path().join("manifest.json")).unwrap();
+        let e = format!("{:#}", discover(d.path(), &[]).unwrap_err());
+        assert!(
+            e.contains("manifest.json") && e.contains("not a regular file"),
+            "{e}"
+        );
     }
 }
