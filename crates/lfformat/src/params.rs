@@ -170,7 +170,7 @@ trait IniValue: Sized {
 }
 
 impl IniValue for f64 {
-    const KIND: &'static str = "a number";
+    const KIND: &'static str = "a finite number";
 
     /// Shortest round-trip form, with `.0` added to integral values as HCI writes them
     /// (Rust's `Display` never uses an exponent, so a `.` is all that can be missing).
@@ -183,8 +183,9 @@ impl IniValue for f64 {
         }
     }
 
+    /// `nan` and `inf` parse as `f64` but are no camera value, size or disparity.
     fn parse(text: &str) -> Option<Self> {
-        text.parse().ok()
+        text.parse().ok().filter(|v: &f64| v.is_finite())
     }
 }
 

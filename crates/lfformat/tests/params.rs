@@ -136,6 +136,23 @@ fn errors_name_the_missing_or_bad_key() {
     assert!(error_text("[intrinsics]\nfocal_length_mm 1.0").contains("line 2: expected"));
 }
 
+/// `nan` and `inf` parse as floats but are no camera value: they are refused naming the key
+/// (`lfeval --range auto` dropped a `disp_min = nan` scene's range in silence).
+#[test]
+fn numbers_that_are_not_finite_are_refused() {
+    let full = boxes().to_ini();
+    for value in ["nan", "NaN", "inf", "-inf"] {
+        let bad = full.replace("fstop = 100.0", &format!("fstop = {value}"));
+        let message = error_text(&bad);
+        assert!(
+            message.contains(&format!(
+                "[intrinsics] fstop = \"{value}\" is not a finite number"
+            )),
+            "{message}"
+        );
+    }
+}
+
 #[test]
 fn reading_a_missing_file_names_it() {
     let path = Path::new("/nonexistent/parameters.cfg");
