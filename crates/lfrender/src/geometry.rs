@@ -4,11 +4,12 @@
 
 use super::material::RenderMaterial;
 use super::sampler::RayKey;
+use crate::build_boxes::build_boxes;
 use crate::scene::shapes::MeshTri;
 use anyhow::{Result, bail};
 use glam::{Vec2, Vec3, Vec3A};
 use obvhs::{
-    BvhBuildParams, cwbvh::CwBvh, cwbvh::builder::build_cwbvh_from_tris, ray::Ray, ray::RayHit,
+    BvhBuildParams, cwbvh::CwBvh, cwbvh::builder::build_cwbvh, ray::Ray, ray::RayHit,
     triangle::Triangle,
 };
 use std::time::Duration;
@@ -87,8 +88,8 @@ impl Geometry {
                 Triangle { v0, v1, v2 }
             })
             .collect();
-        let bvh = build_cwbvh_from_tris(
-            &prims,
+        let bvh = build_cwbvh(
+            &build_boxes(&prims),
             BvhBuildParams::medium_build(),
             &mut Duration::default(),
         );

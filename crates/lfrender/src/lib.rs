@@ -8,6 +8,7 @@
 use lfscene::{camera, scene, textures, util};
 
 pub mod bsdf;
+mod build_boxes;
 pub mod cache;
 pub mod framing;
 pub mod geometry;
