@@ -179,12 +179,14 @@ impl Source {
         }
     }
 
-    /// Mesh-space triangles of a mesh (an OBJ has one primitive and one UV set per mesh).
+    /// Mesh-space triangles of a mesh (an OBJ has one primitive and one UV set per mesh),
+    /// exact repeats left out.
     fn primitive_triangles(&self, key: MeshKey) -> Result<Vec<MeshTri>> {
-        match self {
+        let tris = match self {
             Source::Gltf(f) => f.primitive_triangles(key.mesh, key.primitive, key.uv_set),
             Source::Obj(f) => f.mesh_triangles(key.mesh),
-        }
+        };
+        tris.map(MeshTri::without_repeats)
     }
 
     /// The description for `scene.json`, with every file read so far.

@@ -15,6 +15,35 @@ pub struct MeshTri {
     pub uv: [Vec2; 3],
 }
 
+impl MeshTri {
+    /// `tris` in order without the triangles that repeat an earlier one exactly: the same
+    /// corners in the same winding (from any corner). A repeat adds no surface — hits on it
+    /// are hits on the first — yet every ray through it tests and collects both, so a file
+    /// of millions of copies of one face would take hours to render. A face repeated with the
+    /// opposite winding (a two-sided mesh made of back faces) is kept.
+    pub fn without_repeats(tris: Vec<MeshTri>) -> Vec<MeshTri> {
+        let keys: Vec<[[u32; 3]; 3]> = tris.iter().map(MeshTri::corner_key).collect();
+        let mut order: Vec<u32> = (0..tris.len() as u32).collect();
+        order.sort_unstable_by_key(|&i| (keys[i as usize], i));
+        let mut repeat = vec![false; tris.len()];
+        for run in order.chunk_by(|&a, &b| keys[a as usize] == keys[b as usize]) {
+            run[1..].iter().for_each(|&i| repeat[i as usize] = true);
+        }
+        let mut repeats = repeat.into_iter();
+        let mut tris = tris;
+        tris.retain(|_| repeats.next() == Some(false));
+        tris
+    }
+
+    /// The corners' bits, rotated to start at the smallest: equal for the same triangle
+    /// whichever corner a file lists first, different for the opposite winding.
+    fn corner_key(&self) -> [[u32; 3]; 3] {
+        let c = self.p.map(|p| p.to_array().map(f32::to_bits));
+        let first = (0..3).min_by_key(|&k| c[k]).unwrap_or(0);
+        [0, 1, 2].map(|k| c[(first + k) % 3])
+    }
+}
+
 impl SceneDesc {
     /// Tessellates the objects in order into world-space triangles and hands each to
     /// `each(index, object, triangles)`, after checking its material index; errors name the
@@ -310,6 +339,28 @@ fn is_sliver(p: &[Vec3; 3]) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn exact_repeats_are_left_out_and_the_opposite_winding_kept() {
+        let tri = |p: [[f32; 3]; 3], u: f32| MeshTri {
+            p: p.map(Vec3::from),
+            n: [Vec3::Z; 3],
+            uv: [Vec2::splat(u); 3],
+        };
+        let (a, b, c, d) = ([0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]);
+        let tris = vec![
+            tri([a, b, c], 0.0),
+            tri([b, d, c], 0.0),
+            tri([a, b, c], 1.0), // a repeat: left out, the first one's UVs stay
+            tri([b, c, a], 2.0), // the same winding from another corner: left out
+            tri([a, c, b], 3.0), // the opposite winding: kept
+            tri([b, d, c], 4.0),
+        ];
+        let kept = MeshTri::without_repeats(tris.clone());
+        assert_eq!(kept, [tris[0], tris[1], tris[4]]);
+        let many = MeshTri::without_repeats(vec![tris[0]; 100_000]);
+        assert_eq!(many, [tris[0]]);
+    }
 
     fn tris(shape: Shape) -> Vec<MeshTri> {
         let mut out = Vec::new();
