@@ -323,6 +323,19 @@ fn each_known_hostile_scene_value_is_refused_naming_the_field() {
             }),
         ),
         ("colour", Box::new(|v| v["colour"] = true.into())),
+        // Values of the wrong type are refused while reading, naming the field too.
+        (
+            "camera.resolution[0]",
+            Box::new(|v| v["camera"]["resolution"] = serde_json::json!([-32, 32])),
+        ),
+        (
+            "camera.resolution",
+            Box::new(|v| v["camera"]["resolution"] = serde_json::json!("32x32")),
+        ),
+        (
+            "camera.resolution[1]",
+            Box::new(|v| v["camera"]["resolution"] = serde_json::json!([32, 32.5])),
+        ),
     ];
     let dir = tempfile::tempdir().unwrap();
     for (i, (needle, damage)) in cases.iter().enumerate() {

@@ -23,12 +23,26 @@ const MAX_SEGMENTS: u32 = 65536;
 /// gone at the scale of a pixel.
 const MAX_EXTENT: f32 = 1e6;
 
+/// `bytes` as a scene description; a value of the wrong type names its field
+/// (`camera.resolution[0]: invalid value: integer `-32`, expected u32`), not only its line and
+/// column.
+fn parse(bytes: &[u8]) -> Result<SceneDesc> {
+    let mut json = serde_json::Deserializer::from_slice(bytes);
+    let desc =
+        serde_path_to_error::deserialize(&mut json).map_err(|e| match e.path().iter().next() {
+            Some(_) => anyhow::anyhow!("{}: {}", e.path(), e.inner()),
+            None => anyhow::anyhow!("{}", e.inner()),
+        })?;
+    json.end()?;
+    Ok(desc)
+}
+
 impl SceneDesc {
     /// Reads a saved `scene.json` and validates it, naming the file in errors: the scene
     /// layer owns both the type and its checks, so no reader can skip them.
     pub fn read(path: &Path) -> Result<Self> {
         let bytes = super::files::read_limited(path)?;
-        let desc: SceneDesc = serde_json::from_slice(&bytes)
+        let desc = parse(&bytes)
             .with_context(|| format!("{}: not a valid lfgen scene", path.display()))?;
         desc.validate()
             .with_context(|| format!("{}: not a valid lfgen scene", path.display()))?;
