@@ -37,9 +37,14 @@ impl GltfFile {
     ) -> Result<Vec<[f32; N]>> {
         let label = label(acc, what);
         let layout = self.layout(acc, N, &label)?;
+        ensure!(
+            acc.data_type() != DataType::U32,
+            "{label}: unsigned int components are for indices only (glTF allows float, byte \
+             and short attributes)"
+        );
         let normalized = acc.normalized();
         ensure!(
-            !(normalized && matches!(acc.data_type(), DataType::F32 | DataType::U32)),
+            !(normalized && acc.data_type() == DataType::F32),
             "{label}: normalized {:?} data is not allowed",
             acc.data_type()
         );
