@@ -81,13 +81,24 @@ pub fn evaluate_dataset(
             );
         }
     }
+    // Present in any form counts as ground truth: a FIFO or a broken link there is an error
+    // when the scene is read, not a test scene to leave out.
     let (with_gt, without): (Vec<SceneDir>, Vec<SceneDir>) = scenes
         .into_iter()
-        .partition(|s| s.path.join(HCI_GT_FILE).is_file());
+        .partition(|s| s.path.join(HCI_GT_FILE).symlink_metadata().is_ok());
     if with_gt.is_empty() {
         bail!(
             "{}: no scene has {HCI_GT_FILE}, nothing to evaluate",
             dataset.display()
+        );
+    }
+    if let Some(first) = without.first() {
+        lfformat::note!(
+            "warning: {} scene(s) without {HCI_GT_FILE} left out of the scores ({}{}); they are \
+             listed as skipped_scenes in metrics.json",
+            without.len(),
+            first.name,
+            if without.len() > 1 { ", …" } else { "" }
         );
     }
     let bar = progress(with_gt.len(), "evaluating", opts.quiet);

@@ -322,3 +322,45 @@ fn a_report_image_that_cannot_be_written_fails_the_run_and_leaves_nothing() {
         std::fs::remove_dir_all(&report).unwrap();
     }
 }
+
+/// A scene without `gt_disp_lowres.pfm` (an HCI test scene) is left out of the scores with a
+/// warning naming it and listed in metrics.json; one whose ground truth is there but no
+/// regular file (a FIFO) is an error naming the file, never a silently skipped scene.
+#[test]
+fn a_scene_without_ground_truth_is_named_and_one_with_a_broken_ground_truth_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let ds = tmp.path().join("dataset");
+    write_scene(&ds.join("scene_a"), 1);
+    write_scene(&ds.join("scene_b"), 1);
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let (truth, report) = (tmp.path().join("truth"), tmp.path().join("report"));
+    lfeval(&["truth", &s(&ds), "--out", &s(&truth), "--quiet"]);
+    let gt = ds.join("scene_b/gt_disp_lowres.pfm");
+    std::fs::remove_file(&gt).unwrap();
+    let run = || {
+        Command::new("timeout")
+            .arg("60")
+            .arg(env!("CARGO_BIN_EXE_lfeval"))
+            .args([&s(&ds), &s(&truth), "--out", &s(&report), "--quiet"])
+            .output()
+            .expect("lfeval runs")
+    };
+    let r = run();
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(r.status.success(), "{err}");
+    assert!(
+        err.contains("warning: 1 scene(s) without gt_disp_lowres.pfm") && err.contains("scene_b"),
+        "{err}"
+    );
+    let metrics: Value =
+        serde_json::from_slice(&std::fs::read(report.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(metrics["skipped_scenes"], serde_json::json!(["scene_b"]));
+    assert!(Command::new("mkfifo").arg(&gt).status().unwrap().success());
+    let r = run();
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("scene_b/gt_disp_lowres.pfm") && err.contains("not a regular file"),
+        "{err}"
+    );
+}
