@@ -342,7 +342,10 @@ fn hostile_files_are_rejected_with_errors_naming_the_problem() {
         ("node_cycle.gltf", "reached twice"),
         ("draco_required.gltf", "KHR_draco_mesh_compression"),
         ("lines.gltf", "only TRIANGLES"),
-        ("position_uint.gltf", "unsigned int components are for indices only"),
+        (
+            "position_uint.gltf",
+            "unsigned int components are for indices only",
+        ),
         ("bad_length.glb", "GLB header declares"),
     ];
     let cfg = config([16, 16]);

@@ -66,7 +66,9 @@ fn threads_outside_1_to_1024_is_a_usage_error_naming_the_flag() {
         let out = lfeval(args);
         let err = stderr(&out);
         assert!(
-            out.status.code() == Some(2) && err.contains("--threads <N>") && err.contains("1..=1024"),
+            out.status.code() == Some(2)
+                && err.contains("--threads <N>")
+                && err.contains("1..=1024"),
             "{args:?}: {:?} {err}",
             out.status
         );
@@ -77,7 +79,10 @@ fn threads_outside_1_to_1024_is_a_usage_error_naming_the_flag() {
 fn man_page_and_completions_come_from_the_flag_definitions() {
     let man = lfeval(&["man"]);
     let page = String::from_utf8_lossy(&man.stdout);
-    assert!(man.status.success() && page.contains(".TH lfeval 1"), "{page}");
+    assert!(
+        man.status.success() && page.contains(".TH lfeval 1"),
+        "{page}"
+    );
     let bash = lfeval(&["completions", "bash"]);
     let script = String::from_utf8_lossy(&bash.stdout);
     assert!(

@@ -44,8 +44,26 @@ fn refused(args: &[&str], needle: &str) {
 #[test]
 fn quiet_and_threads_go_before_or_after_the_command_name() {
     for args in [
-        &["-q", "--threads", "2", "predict", MISSING, MISSING, "--out", "p"][..],
-        &["predict", MISSING, MISSING, "--out", "p", "--quiet", "--threads", "2"],
+        &[
+            "-q",
+            "--threads",
+            "2",
+            "predict",
+            MISSING,
+            MISSING,
+            "--out",
+            "p",
+        ][..],
+        &[
+            "predict",
+            MISSING,
+            MISSING,
+            "--out",
+            "p",
+            "--quiet",
+            "--threads",
+            "2",
+        ],
         &["--threads", "1", "bench", "--loader", MISSING, "-q"],
     ] {
         reads_the_missing_path(args);
@@ -69,7 +87,11 @@ fn bench_refuses_the_flags_its_mode_would_ignore() {
         let args = [&["bench", "--loader", MISSING][..], &flag].concat();
         refused(&args, "'--loader <DATASET>' cannot be used with");
     }
-    for flag in [["--batches", "3"], ["--scene-pool", "4"], ["--pool-refresh", "2"]] {
+    for flag in [
+        ["--batches", "3"],
+        ["--scene-pool", "4"],
+        ["--pool-refresh", "2"],
+    ] {
         let args = [&["bench"][..], &flag].concat();
         refused(&args, "--loader <DATASET>");
     }
@@ -98,7 +120,10 @@ fn bench_takes_each_mode_with_its_own_flags() {
 fn man_page_and_completions_come_from_the_flag_definitions() {
     let man = lftrain(&["man"]);
     let page = String::from_utf8_lossy(&man.stdout);
-    assert!(man.status.success() && page.contains(".TH lftrain 1"), "{page}");
+    assert!(
+        man.status.success() && page.contains(".TH lftrain 1"),
+        "{page}"
+    );
     let bash = lftrain(&["completions", "bash"]);
     let script = String::from_utf8_lossy(&bash.stdout);
     assert!(
