@@ -269,6 +269,35 @@ fn refused_within_4_gib(args: &[&str], needles: &[&str]) {
     );
 }
 
+/// `json` with `nodes` as its scene, written to `dir/name` and rendered (with `extra`) under
+/// [`refused_within_4_gib`]: refused naming the file and every one of `needles`. Returns the
+/// output folder the refused run was given.
+fn gltf_refused(
+    dir: &Path,
+    name: &str,
+    mut json: Value,
+    nodes: Vec<Value>,
+    extra: &[&str],
+    needles: &[&str],
+) -> PathBuf {
+    json["scenes"][0]["nodes"] = (0..nodes.len()).collect();
+    json["nodes"] = nodes.into();
+    let gltf = dir.join(name);
+    fs::write(&gltf, json.to_string()).unwrap();
+    let out = dir.join("out");
+    let mut args = vec![
+        "render",
+        gltf.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend(extra);
+    let mut all = vec![name];
+    all.extend(needles);
+    refused_within_4_gib(&args, &all);
+    out
+}
+
 /// Eight distinct 16384² textures in a glTF under a 4 GiB limit: the first ones decode, the
 /// one that no longer fits is refused from its header with its size, the estimate and the
 /// limit — not a panic inside the decoder.
@@ -315,24 +344,19 @@ fn eight_16k_textures_are_refused_before_they_exhaust_memory() {
         })
         .collect();
     nodes.push(json["nodes"][0].clone());
-    json["scenes"][0]["nodes"] = (0..nodes.len()).collect();
-    json["nodes"] = nodes.into();
-    let gltf = dir.path().join("textures.gltf");
-    fs::write(&gltf, json.to_string()).unwrap();
-    let out = dir.path().join("out");
-    refused_within_4_gib(
+    let out = gltf_refused(
+        dir.path(),
+        "textures.gltf",
+        json,
+        nodes,
         &[
-            "render",
-            gltf.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
             "--quiet",
             "--set",
             "camera.resolution=[16,16]",
             "--set",
             "camera.grid=[1,1]",
         ],
-        &["textures.gltf", "16384×16384", "MiB", "memory limit of"],
+        &["16384×16384", "MiB", "memory limit of"],
     );
     assert!(!out.exists());
 }
@@ -442,19 +466,13 @@ fn gltf_triangles_are_counted_from_the_accessors_before_they_are_read() {
         node["translation"] = json!([0.0, 0.0, -2.0 - 0.01 * i as f64]);
         node
     }));
-    json["scenes"][0]["nodes"] = (0..nodes.len()).collect();
-    json["nodes"] = nodes.into();
-    let gltf = dir.path().join("instances.gltf");
-    fs::write(&gltf, json.to_string()).unwrap();
-    let out = dir.path().join("out");
-    refused_within_4_gib(
-        &[
-            "render",
-            gltf.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ],
-        &["instances.gltf", "(1000000 triangles)", "memory limit of"],
+    gltf_refused(
+        dir.path(),
+        "instances.gltf",
+        json,
+        nodes,
+        &[],
+        &["(1000000 triangles)", "memory limit of"],
     );
 }
 

@@ -2,9 +2,9 @@
 //! stochastic transparency, every hit along a ray (for the depth slices), and shadow
 //! transmittance.
 
+use super::build_boxes::build_boxes;
 use super::material::RenderMaterial;
 use super::sampler::RayKey;
-use crate::build_boxes::build_boxes;
 use crate::scene::shapes::MeshTri;
 use anyhow::{Result, bail};
 use glam::{Vec2, Vec3, Vec3A};
