@@ -20,6 +20,7 @@ pub mod params;
 pub mod pfm;
 pub mod png;
 pub mod read;
+pub mod region_masks;
 pub mod results;
 pub mod views;
 
