@@ -6,23 +6,12 @@
 //! metrics (KLD over disparity bins, sparsification, AuSE), and reports with plots. A classical
 //! cost-volume estimator ([`baseline`]) gives every dataset a yardstick that needs no training.
 //!
-//! Layout: [`bins`] and [`laplace`] are the discretisation maths, [`posterior`] the predicted
-//! distributions, [`truth`] the ground truth, [`metrics`] the pure metric functions,
-//! [`scene_eval`] one method on one scene, [`summary`] one method over a dataset,
-//! [`prediction`] (with [`npz`]) the files read (scene discovery and views: `lfformat`), [`pipeline`] the dataset
-//! loops with I/O and progress, [`report`] the output files.
+//! Layout: the data it reads and the metric functions are `lfdata`'s (the ground truth, the
+//! prediction and posterior formats, bins, the metrics of one method on one scene, shared
+//! with `lftrain`'s validation); [`summary`] is one method over a dataset, [`pipeline`] the
+//! dataset loops with I/O and progress, [`report`] the output files.
 
 pub mod baseline;
-pub mod bins;
-pub mod laplace;
-pub mod metrics;
-pub mod npz;
 pub mod pipeline;
-pub mod posterior;
-pub mod prediction;
 pub mod report;
-pub mod scene_eval;
 pub mod summary;
-pub mod truth;
-
-pub use bins::Bins;

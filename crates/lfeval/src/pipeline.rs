@@ -7,36 +7,22 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use indicatif::{ParallelProgressIterator, ProgressBar, ProgressIterator, ProgressStyle};
+use indicatif::{ParallelProgressIterator, ProgressIterator};
+use lfdata::bins::Bins;
+use lfdata::prediction::{Method, write_prediction};
+use lfdata::progress::progress;
+use lfdata::scene_eval::{EvalConfig, MAIN_BADPIX, PreparedTruth, SceneScores, evaluate};
+use lfdata::truth::{EtaKind, HCI_GT_FILE, Reference, SceneTruth};
+use lfformat::dataset::SceneDir;
+use lfformat::views::{LightField, centre_view};
 use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::baseline::{self, BaselineConfig};
-use crate::bins::Bins;
-use crate::prediction::{Method, write_prediction};
 use crate::report::errormap::{self, badpix_map, luminance};
 use crate::report::samples::{PixelRequest, PosteriorSample, auto_pixels};
 use crate::report::{ERROR_MAP_DIR, Evaluation, MethodResult};
-use crate::scene_eval::{EvalConfig, MAIN_BADPIX, PreparedTruth, SceneScores, evaluate};
 use crate::summary::MethodSummary;
-use crate::truth::{EtaKind, HCI_GT_FILE, Reference, SceneTruth};
-use lfformat::dataset::SceneDir;
-use lfformat::views::{LightField, centre_view};
-
-/// A progress bar on stderr, hidden when `quiet` (indicatif also hides it off a terminal).
-pub fn progress(len: usize, message: &str, quiet: bool) -> ProgressBar {
-    if quiet {
-        return ProgressBar::hidden();
-    }
-    let style = ProgressStyle::with_template(
-        "{msg} [{bar:30}] {pos}/{len} scenes, {elapsed_precise} (eta {eta})",
-    )
-    .expect("valid template")
-    .progress_chars("=> ");
-    ProgressBar::new(len as u64)
-        .with_style(style)
-        .with_message(message.to_string())
-}
 
 /// Options of [`evaluate_dataset`] beyond the metric settings.
 #[derive(Clone, Debug, Default)]

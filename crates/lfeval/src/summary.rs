@@ -7,13 +7,13 @@
 
 use std::collections::BTreeMap;
 
+use lfdata::metrics::hci::HciScores;
+use lfdata::metrics::kld::{KldScores, KldSums};
+use lfdata::metrics::mean;
+use lfdata::metrics::sparsification::{Sparsification, fractions};
+use lfdata::scene_eval::SceneScores;
+use lfdata::truth::Reference;
 use serde::Serialize;
-
-use crate::metrics::hci::HciScores;
-use crate::metrics::kld::{KldScores, KldSums};
-use crate::metrics::sparsification::{Sparsification, fractions};
-use crate::scene_eval::SceneScores;
-use crate::truth::Reference;
 
 /// A sparsification curve over the dataset, with its Oracle, SE and AuSE.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -108,18 +108,10 @@ fn mean_scores(scores: impl Iterator<Item = HciScores> + Clone) -> HciScores {
     }))
 }
 
-/// Mean of the present values, `None` if there are none.
-pub fn mean(values: impl Iterator<Item = Option<f64>>) -> Option<f64> {
-    let (sum, n) = values
-        .flatten()
-        .fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
-    (n > 0).then(|| sum / n as f64)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene_eval::SparsificationPair;
+    use lfdata::scene_eval::SparsificationPair;
 
     fn scene(mse: f64, kld: f64, runtime: Option<f64>, curve: Option<Vec<f64>>) -> SceneScores {
         let scores = HciScores {

@@ -1,6 +1,6 @@
 //! Photometric augmentations of the thesis (§5.3.1): a rotation of the colours in RGB space and
 //! random brightness and contrast. The geometric ones (EPI shift, 90° rotation) live with the
-//! geometry in [`crate::stacks`] and [`crate::lightfield`].
+//! geometry in [`lfdata::stacks`] and [`lfdata::lightfield`].
 
 use rand::{Rng, RngExt};
 

@@ -1,10 +1,11 @@
 //! What the network reads per stack direction ([`crate::config::NetInput`]): the stack's
 //! views, or its plane-sweep cost volume over the `[dpp]` bin centres.
 
+use lfdata::lightfield::LightField;
+use lfdata::stack_cost::cost_stack;
+use lfdata::stacks::{Direction, Region, extract};
+
 use crate::config::{NetInput, TrainConfig};
-use crate::cost::cost_stack;
-use crate::lightfield::LightField;
-use crate::stacks::{Direction, Region, extract};
 
 /// The input of a run, resolved once from its configuration.
 #[derive(Clone, Debug, PartialEq)]

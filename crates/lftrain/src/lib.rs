@@ -8,10 +8,11 @@
 //! datasets (multimodal ground truth) or plain HCI scenes, and writes predictions in the
 //! formats `lfeval` reads.
 //!
-//! Layout: the data pipeline is [`lightfield`] (views, crop, rotation), [`stacks`] (the four
-//! stacks and the EPI shift), [`cost`] and [`input`] (a stack's cost volume, the alternative
-//! network input, which [`costnet`] can aggregate), [`augment`] (colours), [`scene`]
-//! (targets), [`sample`] (one augmented crop, batches) and [`loader`] (background prefetch);
+//! Layout: the light field, its four stacks, the EPI shift and a stack's cost volume are
+//! `lfdata`'s (shared with `lfeval`); the data pipeline is [`input`] (the stacks or their cost
+//! volume, the alternative network input, which [`costnet`] can aggregate), [`augment`]
+//! (colours), [`scene`] (targets), [`sample`] (one augmented crop, batches) and [`loader`]
+//! (background prefetch);
 //! the learning side is [`model`], [`loss`] and [`tensors`]; EPI-Shift's own parts are
 //! [`shift_sample`], [`unet`], [`epishift`], [`shift_loss`] and [`shift_predict`]; [`train`],
 //! [`validate`], [`predict`], [`run`] (the run folder) and [`log`] are the commands'
@@ -19,11 +20,9 @@
 
 pub mod augment;
 pub mod config;
-pub mod cost;
 pub mod costnet;
 pub mod epishift;
 pub mod input;
-pub mod lightfield;
 pub mod loader;
 pub mod log;
 pub mod loss;
@@ -36,7 +35,6 @@ pub mod scene;
 pub mod shift_loss;
 pub mod shift_predict;
 pub mod shift_sample;
-pub mod stacks;
 pub mod synthetic;
 pub mod tensors;
 pub mod train;

@@ -7,6 +7,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, anyhow};
+use lfdata::font;
 use plotters::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -114,21 +115,9 @@ fn write_row(f: &mut File, r: &Record) -> std::io::Result<()> {
     )
 }
 
-/// Font family name of the embedded DejaVu Sans (lfeval's asset, shared, not copied).
-const FONT: &str = "lftrain-sans";
-static FONT_DATA: &[u8] = include_bytes!("../../lfeval/assets/DejaVuSans.ttf");
-
-/// Registers the font once per process (plotters draws no text without one here).
-fn font() -> Result<()> {
-    static OK: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-    OK.get_or_init(|| plotters::style::register_font(FONT, FontStyle::Normal, FONT_DATA).is_ok())
-        .then_some(())
-        .ok_or_else(|| anyhow!("the embedded font could not be loaded"))
-}
-
 /// Training loss (left) and validation BadPix(0.07) (right) over steps.
 pub fn plot(records: &[Record], path: &Path) -> Result<()> {
-    font()?;
+    font::register()?;
     let (w, h) = (1000u32, 400u32);
     let mut buf = vec![0u8; (w * h * 3) as usize];
     {
@@ -169,7 +158,7 @@ fn series<DB: DrawingBackend>(
         (y_min.min(0.0) - 1.0, y_max.max(0.0) + 1.0)
     };
     let mut chart = ChartBuilder::on(area)
-        .caption(title, (FONT, 18))
+        .caption(title, (font::FAMILY, 18))
         .margin(10)
         .x_label_area_size(30)
         .y_label_area_size(50)
@@ -178,7 +167,7 @@ fn series<DB: DrawingBackend>(
     chart
         .configure_mesh()
         .x_desc("step")
-        .label_style((FONT, 12))
+        .label_style((font::FAMILY, 12))
         .draw()
         .map_err(plot_error)?;
     chart

@@ -73,7 +73,7 @@ pub(crate) fn blocks(cin: usize, width: usize, count: usize, device: &Device) ->
 
 /// Quarter turn of `[B, C, H, W]` images that maps the 90° stack's EPIs onto the 0° stack's
 /// (and the 45° stack onto the −45° one): `new[i][j] = old[H-1-j][i]`, i.e. the centred map
-/// `(x, y) → (-y, x)` (clockwise as displayed). See [`crate::stacks`] for the stack order.
+/// `(x, y) → (-y, x)` (clockwise as displayed). See [`lfdata::stacks`] for the stack order.
 pub fn turn_to_reference(x: Tensor<4>) -> Tensor<4> {
     x.swap_dims(2, 3).flip([3])
 }

@@ -5,18 +5,18 @@
 use std::time::Instant;
 
 use burn::prelude::*;
-use lfeval::posterior::{PixelPosterior, PosteriorForm, PosteriorMap};
-use lfeval::prediction::ScenePrediction;
-use lfeval::{Bins, laplace};
+use lfdata::lightfield::{LightField, rotate_plane};
+use lfdata::posterior::{PixelPosterior, PosteriorForm, PosteriorMap};
+use lfdata::prediction::ScenePrediction;
+use lfdata::stacks::{Direction, Region};
+use lfdata::{Bins, laplace};
 use lfformat::pfm::FloatImage;
 
 use crate::config::{EsePoint, ModelKind, NetInput, TrainConfig};
 use crate::epishift::EpiShiftNet;
 use crate::input::StackInput;
-use crate::lightfield::{LightField, rotate_plane};
 use crate::model::{Network, StackNet, decode};
 use crate::shift_predict::estimate;
-use crate::stacks::{Direction, Region};
 use crate::tensors::{tensor4, values};
 
 /// Raw network outputs `[C][H·W]` (channel planes) for `lf` EPI-shifted by `shift`, averaged
@@ -408,7 +408,7 @@ pub fn predict_dataset_over(
     let device = crate::train::default_device();
     let net = run.load_net(&cfg, state.grid, &device)?.valid();
     let scenes = lfformat::dataset::discover(dataset, &[])?;
-    let bar = lfeval::pipeline::progress(scenes.len(), "predicting", quiet);
+    let bar = lfdata::progress::progress(scenes.len(), "predicting", quiet);
     let mut ranges = Vec::new();
     for s in &scenes {
         let lf = LightField::load(&s.path)?;
@@ -424,7 +424,7 @@ pub fn predict_dataset_over(
             );
         }
         let pred = predict(&cfg, &net, &lf, &device);
-        lfeval::prediction::write_prediction(out, &s.name, &pred)?;
+        lfdata::prediction::write_prediction(out, &s.name, &pred)?;
         bar.inc(1);
     }
     bar.finish_and_clear();

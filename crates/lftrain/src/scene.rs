@@ -3,12 +3,11 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
-use lfeval::truth::{EtaKind, SceneTruth, dominant, eta_of, front};
+use lfdata::lightfield::LightField;
+use lfdata::truth::{EtaKind, SceneTruth, dominant, eta_of, front};
 use lfformat::Mode;
 
 use crate::config::{TrainConfig, UnimodalTarget};
-
-use crate::lightfield::LightField;
 use crate::mask::texture_mask;
 
 /// Per-pixel disparity targets: `modes` pairs `(d_j, η_j)` per pixel, interleaved

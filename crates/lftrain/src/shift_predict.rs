@@ -6,11 +6,11 @@
 use std::collections::VecDeque;
 
 use burn::prelude::*;
+use lfdata::lightfield::LightField;
+use lfdata::stacks::{Direction, Region, extract};
 
 use crate::config::{EpiShiftConfig, MAX_SHIFTS};
 use crate::epishift::EpiShiftNet;
-use crate::lightfield::LightField;
-use crate::stacks::{Direction, Region, extract};
 use crate::tensors::{tensor4, values};
 
 /// The range assumed for a light field without `parameters.cfg` (built in memory): the

@@ -7,10 +7,11 @@
 //! no interpolation. Where a shifted view would read outside the scene, the nearest edge pixel
 //! is repeated ("clipping") and the pixel gets no loss at that shift.
 
-use crate::lightfield::{crop_plane, rotate_plane};
+use lfdata::lightfield::{crop_plane, rotate_plane};
+use lfdata::stacks::{Direction, Region, extract};
+
 use crate::sample::{Draw, loss_region, target_planes};
 use crate::scene::Scene;
-use crate::stacks::{Direction, Region, extract};
 
 /// One EPI-Shift sample of a `patch²` crop with `S` shifts `base + k`, `k = −K ..= K`.
 #[derive(Clone, Debug, PartialEq)]

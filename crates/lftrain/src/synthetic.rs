@@ -7,10 +7,9 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
+use lfdata::lightfield::LightField;
 use lfformat::pfm::{FloatImage, write_pfm};
 use lfformat::{HciParameters, Mode, ModeMap};
-
-use crate::lightfield::LightField;
 
 /// The scene description; coordinates are centre-relative pixels of the centre view
 /// (x right, y down), disparities in pixels per view step.
@@ -68,7 +67,7 @@ impl TwoPlanes {
     }
 
     /// The scene point `p` expressed in the unrotated scene: `R^-turns p` with
-    /// `R⁻¹(a, b) = (-b, a)` (the inverse of the quarter turn of [`crate::lightfield`]).
+    /// `R⁻¹(a, b) = (-b, a)` (the inverse of the quarter turn of [`lfdata::lightfield`]).
     fn unrotate(&self, (mut a, mut b): (f32, f32)) -> (f32, f32) {
         for _ in 0..self.turns % 4 {
             (a, b) = (-b, a);

@@ -3,16 +3,16 @@
 
 use anyhow::Result;
 use burn::prelude::*;
-use lfeval::metrics::kld::KldSums;
-use lfeval::scene_eval::{EvalConfig, PreparedTruth, evaluate};
-use lfeval::summary::mean;
-use lfeval::truth::{Reference, SceneTruth};
+use lfdata::lightfield::LightField;
+use lfdata::metrics::kld::KldSums;
+use lfdata::metrics::mean;
+use lfdata::scene_eval::{EvalConfig, PreparedTruth, evaluate};
+use lfdata::truth::{Reference, SceneTruth};
 use lfformat::dataset::SceneDir;
 use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::config::TrainConfig;
-use crate::lightfield::LightField;
 use crate::model::Network;
 use crate::predict::predict;
 

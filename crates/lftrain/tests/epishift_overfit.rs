@@ -91,7 +91,7 @@ fn tiny_epishift_overfits_a_tiny_dataset_then_predicts_far_disparities() {
     };
     lftrain::predict::predict_dataset_over(&run, &far, &narrow, true, &range).unwrap();
     let score = |p: &std::path::Path| {
-        let m = lfeval::prediction::Method::new(p).unwrap();
+        let m = lfdata::prediction::Method::new(p).unwrap();
         let d = m.load("a", 24, 24).unwrap().disparity;
         let truth = base.hci_disparity();
         let inner: Vec<f32> = (0..24 * 24)

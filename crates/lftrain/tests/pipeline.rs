@@ -1,13 +1,13 @@
 //! The data pipeline against rendered scenes: stack extraction, the EPI shift's sign, and the
 //! rotation augmentation compared with a render of the rotated scene.
 
+use lfdata::lightfield::{LightField, rotate_plane};
+use lfdata::stacks::{Direction, Region, extract};
 use lftrain::augment::Photometric;
 use lftrain::config::AugmentConfig;
 use lftrain::input::StackInput;
-use lftrain::lightfield::{LightField, rotate_plane};
 use lftrain::sample::{Draw, make_sample};
 use lftrain::scene::Scene;
-use lftrain::stacks::{Direction, Region, extract};
 use lftrain::synthetic::TwoPlanes;
 
 fn uni() -> lftrain::scene::Unimodal {

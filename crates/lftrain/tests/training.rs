@@ -4,11 +4,11 @@
 
 use burn::prelude::*;
 use burn::tensor::TensorData;
+use lfdata::stacks::{Direction, Region, extract};
 use lftrain::config::{CostNetwork, EseOutside, ModelKind, NetConfig, NetInput, TrainConfig};
 use lftrain::loss::{TargetTensors, dpp_bin, loss};
 use lftrain::model::{EpiNet, turn_to_reference};
 use lftrain::run::seeded;
-use lftrain::stacks::{Direction, Region, extract};
 use lftrain::synthetic::TwoPlanes;
 use lftrain::tensors::{tensor4, values};
 
@@ -299,7 +299,7 @@ fn overfit(input: NetInput, cost_network: CostNetwork) -> Overfit {
     let pred = tmp.path().join("pred");
     let n = lftrain::predict::predict_dataset(&run, &data, &pred, true).unwrap();
     assert_eq!(n, 2);
-    let method = lfeval::prediction::Method::new(&pred).unwrap();
+    let method = lfdata::prediction::Method::new(&pred).unwrap();
     let loaded = method.load("a", 24, 24).unwrap();
     assert!(loaded.disparity.data.iter().all(|d| d.is_finite()));
     o
@@ -353,8 +353,8 @@ fn every_model_writes_a_posterior_lfeval_reads() {
             point_follows_the_config(c.clone(), &net, &lf, &dev);
         }
         let dir = tmp.path().join(format!("{}_{input:?}", model.name()));
-        lfeval::prediction::write_prediction(&dir, "s", &pred).unwrap();
-        let back = lfeval::prediction::Method::new(&dir)
+        lfdata::prediction::write_prediction(&dir, "s", &pred).unwrap();
+        let back = lfdata::prediction::Method::new(&dir)
             .unwrap()
             .load("s", 10, 10)
             .unwrap();
@@ -365,14 +365,14 @@ fn every_model_writes_a_posterior_lfeval_reads() {
             let (lo, hi) = (c.dpp.min, c.dpp.max);
             let inside = |d: &f32| (lo..=hi).contains(d);
             match back.posterior.as_ref().map(|p| &p.form) {
-                Some(lfeval::posterior::PosteriorForm::Laplace { mu, .. }) => {
+                Some(lfdata::posterior::PosteriorForm::Laplace { mu, .. }) => {
                     assert!(mu.iter().all(inside))
                 }
                 None => assert!(back.disparity.data.iter().all(inside)),
                 _ => {}
             }
         }
-        if let Some(lfeval::posterior::PosteriorForm::Mixture {
+        if let Some(lfdata::posterior::PosteriorForm::Mixture {
             components: m, mu, ..
         }) = back.posterior.map(|p| p.form)
         {
@@ -449,8 +449,8 @@ fn a_patch_larger_than_the_scenes_is_refused_naming_the_scene() {
 
 #[test]
 fn test_rotations_turn_the_prediction_with_the_light_field() {
+    use lfdata::lightfield::{LightField, rotate_plane};
     use lftrain::input::StackInput;
-    use lftrain::lightfield::{LightField, rotate_plane};
     use lftrain::predict::run_net;
     let dev = device();
     // Eight output planes: an untrained net's ReLU before the last convolution leaves some
@@ -514,10 +514,10 @@ fn test_rotations_turn_the_prediction_with_the_light_field() {
 fn point_follows_the_config(
     mut c: TrainConfig,
     net: &lftrain::model::Network,
-    lf: &lftrain::lightfield::LightField,
+    lf: &lfdata::lightfield::LightField,
     dev: &Device,
 ) {
-    use lfeval::posterior::PixelPosterior;
+    use lfdata::posterior::PixelPosterior;
     use lftrain::predict::{mixture_mode, window_mode};
     c.dpp.mode_window = 2;
     c.ese.point = lftrain::config::EsePoint::Mode;

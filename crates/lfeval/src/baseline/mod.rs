@@ -1,21 +1,18 @@
 //! A classical estimator that needs no training, so every dataset has a yardstick and every
 //! metric runs on real data: a photo-consistency cost volume over the disparity bins
-//! ([`cost`]), optionally averaged over a local window, turned into a discrete posterior by a
+//! ([`lfdata::cost`]), optionally averaged over a local window, turned into a discrete posterior by a
 //! softmax of the negative cost with a temperature, and a winner-take-all point estimate.
-
-pub mod cost;
 
 use std::time::Instant;
 
+use lfdata::bins::Bins;
+use lfdata::cost::{box_filter, cost_volume};
+use lfdata::posterior::{PosteriorForm, PosteriorMap};
+use lfdata::prediction::{ScenePrediction, point_estimates};
 use lfformat::pfm::FloatImage;
+use lfformat::views::{LightField, ViewSet};
 use rayon::prelude::*;
 use serde::Serialize;
-
-use crate::bins::Bins;
-use crate::posterior::{PosteriorForm, PosteriorMap};
-use crate::prediction::{ScenePrediction, point_estimates};
-use cost::{box_filter, cost_volume};
-use lfformat::views::{LightField, ViewSet};
 
 /// Settings of the baseline.
 #[derive(Clone, Debug, PartialEq, Serialize)]

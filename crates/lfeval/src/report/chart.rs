@@ -5,21 +5,16 @@
 //! without fonts; pixels are drawn into a buffer and encoded with the `image` crate.
 
 use std::path::Path;
-use std::sync::OnceLock;
 
 use anyhow::{Result, anyhow};
+use lfdata::bins::Bins;
+use lfdata::font;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::Evaluation;
 use super::samples::PosteriorSample;
-use crate::bins::Bins;
 use crate::summary::{CurveSummary, SparsificationSummary};
-
-/// The family name the embedded font is registered under.
-const FONT: &str = "sans-serif";
-/// DejaVu Sans (licence: `assets/DejaVuSans-LICENSE.txt`).
-static FONT_DATA: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 
 /// The two error measures that have sparsification curves.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -49,27 +44,18 @@ impl Measure {
     }
 }
 
-/// Registers the embedded font once per process.
-fn font() -> Result<()> {
-    static REGISTERED: OnceLock<bool> = OnceLock::new();
-    let ok = *REGISTERED
-        .get_or_init(|| plotters::style::register_font(FONT, FontStyle::Normal, FONT_DATA).is_ok());
-    ok.then_some(())
-        .ok_or_else(|| anyhow!("the embedded font could not be loaded"))
-}
-
 /// Any plotting error as an `anyhow` error.
-fn plot_error(e: impl std::fmt::Debug) -> anyhow::Error {
+pub(crate) fn plot_error(e: impl std::fmt::Debug) -> anyhow::Error {
     anyhow!("drawing failed: {e:?}")
 }
 
 /// Draws with `draw` on a white `w × h` canvas and writes it to `path` as PNG.
-fn render(
+pub(crate) fn render(
     path: &Path,
     (w, h): (u32, u32),
     draw: impl FnOnce(&DrawingArea<BitMapBackend, Shift>) -> Result<()>,
 ) -> Result<()> {
-    font()?;
+    font::register()?;
     let mut buffer = vec![255u8; w as usize * h as usize * 3];
     {
         let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
@@ -81,7 +67,7 @@ fn render(
 }
 
 /// Colour of method `i` (colour-blind-friendly Okabe–Ito order).
-fn colour(i: usize) -> RGBColor {
+pub(crate) fn colour(i: usize) -> RGBColor {
     const COLOURS: [RGBColor; 7] = [
         RGBColor(0, 114, 178),
         RGBColor(213, 94, 0),
@@ -146,7 +132,7 @@ fn draw_curves(
         .fold(0.0f64, f64::max);
     let y_max = if y_max > 0.0 { y_max * 1.05 } else { 1.0 };
     let mut chart = ChartBuilder::on(area)
-        .caption(title, (FONT, 20))
+        .caption(title, (font::FAMILY, 20))
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(60)
@@ -155,7 +141,7 @@ fn draw_curves(
     chart
         .configure_mesh()
         .x_desc("fraction of pixels removed")
-        .label_style((FONT, 14))
+        .label_style((font::FAMILY, 14))
         .draw()
         .map_err(plot_error)?;
     for &(i, name, s, c) in curves {
@@ -187,7 +173,7 @@ fn draw_curves(
     if !curves.is_empty() {
         chart
             .configure_series_labels()
-            .label_font((FONT, 14))
+            .label_font((font::FAMILY, 14))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .draw()
@@ -213,7 +199,7 @@ pub fn posterior(sample: &PosteriorSample, bins: &Bins, path: &Path) -> Result<(
             sample.scene, sample.x, sample.y
         );
         let mut chart = ChartBuilder::on(root)
-            .caption(title, (FONT, 20))
+            .caption(title, (font::FAMILY, 20))
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(60)
@@ -223,7 +209,7 @@ pub fn posterior(sample: &PosteriorSample, bins: &Bins, path: &Path) -> Result<(
             .configure_mesh()
             .x_desc("disparity (px)")
             .y_desc("probability per bin / η")
-            .label_style((FONT, 14))
+            .label_style((font::FAMILY, 14))
             .draw()
             .map_err(plot_error)?;
         for (i, m) in sample.methods.iter().enumerate() {
@@ -250,7 +236,7 @@ pub fn posterior(sample: &PosteriorSample, bins: &Bins, path: &Path) -> Result<(
             .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK.stroke_width(3)));
         chart
             .configure_series_labels()
-            .label_font((FONT, 14))
+            .label_font((font::FAMILY, 14))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .draw()

@@ -5,8 +5,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use image::{Rgb, RgbImage};
-
-use crate::metrics::Frame;
+use lfdata::metrics::Frame;
 
 const GOOD: [f32; 3] = [40.0, 200.0, 60.0];
 const BAD: [f32; 3] = [230.0, 40.0, 30.0];
@@ -32,7 +31,7 @@ pub fn badpix_map(
         let e = f64::from(pred[i]) - f64::from(gt[i]);
         if !e.is_finite() {
             Rgb([0, 0, 0])
-        } else if crate::metrics::hci::is_bad(pred[i], gt[i], t) {
+        } else if lfdata::metrics::hci::is_bad(pred[i], gt[i], t) {
             shade(BAD)
         } else {
             shade(GOOD)

@@ -4,12 +4,12 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::Result;
+use lfdata::metrics::hci::HciScores;
+use lfdata::metrics::kld::KldScores;
+use lfdata::scene_eval::{EvalConfig, SceneScores, UncertaintySource};
 use serde::Serialize;
 
 use super::{Evaluation, MethodResult, write_text};
-use crate::metrics::hci::HciScores;
-use crate::metrics::kld::KldScores;
-use crate::scene_eval::{EvalConfig, SceneScores, UncertaintySource};
 use crate::summary::MethodSummary;
 
 #[derive(Serialize)]

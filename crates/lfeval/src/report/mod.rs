@@ -10,12 +10,12 @@ pub mod table;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-
-use crate::prediction::Method;
-use crate::scene_eval::{EvalConfig, SceneScores};
-use crate::summary::MethodSummary;
+use lfdata::prediction::Method;
+use lfdata::scene_eval::{EvalConfig, SceneScores};
 use lfformat::dataset::SceneDir;
 use samples::PosteriorSample;
+
+use crate::summary::MethodSummary;
 
 /// Folder of the per-scene BadPix maps, one sub-folder per method.
 pub const ERROR_MAP_DIR: &str = "error_maps";

@@ -2,13 +2,12 @@
 
 use std::str::FromStr;
 
+use lfdata::bins::Bins;
+use lfdata::metrics::Frame;
+use lfdata::prediction::ScenePrediction;
+use lfdata::scene_eval::predicted_masses;
+use lfdata::truth::{EtaKind, SceneTruth, eta_of};
 use serde::Serialize;
-
-use crate::bins::Bins;
-use crate::metrics::Frame;
-use crate::prediction::ScenePrediction;
-use crate::scene_eval::predicted_masses;
-use crate::truth::{EtaKind, SceneTruth, eta_of};
 
 /// A pixel asked for on the command line as `SCENE:X,Y`.
 #[derive(Clone, Debug, PartialEq, Eq)]

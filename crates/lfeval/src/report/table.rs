@@ -9,12 +9,12 @@ use std::fmt::Write;
 use std::path::Path;
 
 use anyhow::Result;
+use lfdata::metrics::hci::SCORE_NAMES;
+use lfdata::truth::Reference;
 
 use super::{
     Evaluation, POSTERIOR_PLOT_DIR, SPARSIFICATION_PLOTS, posterior_plot_name, write_text,
 };
-use crate::metrics::hci::SCORE_NAMES;
-use crate::truth::Reference;
 
 /// A table of optional numbers with row labels.
 #[derive(Clone, Debug, PartialEq)]

@@ -1,5 +1,5 @@
 //! The plane-sweep cost volume of one stack, the network's input with `net.input = "cost"`
-//! ([`crate::config::NetInput::Cost`]): for each disparity hypothesis `h`, the stack's views
+//! (`lftrain`'s `NetInput::Cost`): for each disparity hypothesis `h`, the stack's views
 //! EPI-shifted by `h` line up wherever the scene has disparity `h`, and their colour variance
 //! is small there (thesis §2.4.2; lfeval's baseline builds the same cost over the cross views
 //! and picks its minimum, the network learns what to make of it).

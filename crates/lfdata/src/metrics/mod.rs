@@ -46,6 +46,14 @@ impl Frame {
     }
 }
 
+/// Mean of the present values, `None` if there are none.
+pub fn mean(values: impl Iterator<Item = Option<f64>>) -> Option<f64> {
+    let (sum, n) = values
+        .flatten()
+        .fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    (n > 0).then(|| sum / n as f64)
+}
+
 #[cfg(test)]
 mod tests {
     use super::Frame;

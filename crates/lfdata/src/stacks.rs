@@ -191,47 +191,6 @@ mod tests {
         assert_eq!(Direction::Vertical.view_indices(3), vec![7, 4, 1]);
     }
 
-    /// The loader colours a crop's views once instead of every resampled stack
-    /// (`sample::make_sample`): a photometric draw is affine per pixel and the resampling's
-    /// weights sum to one, so both orders agree to rounding, also where sampling clamps.
-    #[test]
-    fn a_photometric_draw_commutes_with_the_epi_shift() {
-        use crate::augment::{Photometric, grey_axis_rotation};
-        let lf = LightField::from_fn(9, 20, 20, |u, v, x, y| {
-            let s = ((x * 7 + y * 13 + u * 3 + v * 5) % 17) as f32 / 17.0;
-            [s, 1.0 - s, 0.3 + 0.4 * s * s]
-        });
-        let draw = Photometric {
-            matrix: grey_axis_rotation(1.1),
-            gain: 1.4,
-            stretch: 0.7,
-            contrast: 1.2,
-            brightness: -0.05,
-        };
-        let region = Region {
-            x0: 1,
-            y0: 2,
-            width: 16,
-            height: 15,
-        };
-        let plane = region.width * region.height;
-        let mut coloured = lf.clone();
-        for view in coloured.views.iter_mut().flatten() {
-            draw.apply(view, 1, 0.45);
-        }
-        for dir in Direction::ALL {
-            let mut after = extract(&lf, dir, region, 1.37);
-            draw.apply(&mut after, plane, 0.45);
-            let before = extract(&coloured, dir, region, 1.37);
-            let worst = before
-                .iter()
-                .zip(&after)
-                .map(|(a, b)| (a - b).abs())
-                .fold(0.0, f32::max);
-            assert!(worst < 1e-5, "{dir:?}: {worst}");
-        }
-    }
-
     /// The interior fast path of `sample_shifted` gives bit for bit what clamping every
     /// pixel gives, for shifts that leave the image on either side and regions at its edges.
     #[test]
