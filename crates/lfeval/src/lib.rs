@@ -14,4 +14,5 @@
 pub mod baseline;
 pub mod pipeline;
 pub mod report;
+pub mod robust;
 pub mod summary;

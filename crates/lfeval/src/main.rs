@@ -14,6 +14,7 @@ use lfdata::truth::{EtaKind, Reference};
 use lfeval::baseline::{BaselineConfig, DEFAULT_TEMPERATURE, DEFAULT_WINDOW};
 use lfeval::pipeline::{self, EvalOptions};
 use lfeval::report::{self, samples::PixelRequest};
+use lfeval::robust;
 use lfformat::cli::{Generated, Workers};
 use lfformat::dataset::{PARAMETERS_FILE, SceneDir, discover};
 use lfformat::views::ViewSet;
@@ -49,6 +50,12 @@ enum Command {
     Baseline(BaselineArgs),
     /// Write the ground truth as a method's predictions (checks a pipeline: scores 0).
     Truth(TruthArgs),
+    /// Write seeded, corrupted copies of a dataset's scenes (noise, contrast, exposure,
+    /// vignetting, JPEG) for `lfeval robustness`.
+    Corrupt(CorruptArgs),
+    /// Score every method on every corrupted copy: tables and a plot of BadPix against the
+    /// corruption's strength.
+    Robustness(RobustnessArgs),
     #[command(flatten)]
     Generated(Generated),
     /// Print docs/reference/cli-lfeval.md, generated from the flag definitions.
@@ -193,6 +200,33 @@ struct TruthArgs {
     eta: EtaKind,
 }
 
+#[derive(Args)]
+struct CorruptArgs {
+    /// Dataset root, split folder or scene folder (e.g. the held-out split).
+    dataset: PathBuf,
+    /// New folder for the copies: OUT/<corruption>/[<split>/]<scene>/.
+    #[arg(long)]
+    out: PathBuf,
+    #[command(flatten)]
+    common: Common,
+    /// Seed of the noise (with the scene name and the view).
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+}
+
+#[derive(Args)]
+struct RobustnessArgs {
+    /// The folder `lfeval corrupt` wrote.
+    corrupted: PathBuf,
+    /// One folder per method, holding a prediction folder per corrupted copy, named as it
+    /// (METHOD/clean, METHOD/noise_2, …); the method is named by the folder.
+    #[arg(required = true)]
+    methods: Vec<PathBuf>,
+    /// Report folder to write (robustness.md, robustness.json, robustness.png).
+    #[arg(long, default_value = "lfeval_robustness")]
+    out: PathBuf,
+}
+
 /// `MIN,MAX`, or `auto` (the scenes' own ranges).
 fn parse_range(s: &str) -> Result<RangeArg, String> {
     if s.trim() == "auto" {
@@ -220,6 +254,20 @@ fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Some(Command::Baseline(a)) => baseline(a, quiet),
         Some(Command::Truth(a)) => truth(a, quiet),
+        Some(Command::Corrupt(a)) => {
+            let scenes = discover(&a.dataset, &a.common.splits)?;
+            robust::corrupt_dataset(&scenes, &a.out, a.seed)?;
+            lfformat::note!("corrupted copies written to {}", a.out.display());
+            Ok(())
+        }
+        Some(Command::Robustness(a)) => {
+            let bench = robust::benchmark::score(&a.corrupted, &a.methods, quiet)?;
+            bench.write(&a.out)?;
+            let table = bench.table("BadPix(0.07) %", |s| s.badpix_007);
+            lfformat::console::stdout(format_args!("{}", table.to_markdown()))?;
+            lfformat::note!("report written to {}", a.out.join("robustness.md").display());
+            Ok(())
+        }
         Some(Command::Generated(g)) => Ok(g.print(command())?),
         Some(Command::Doc) => {
             let note = "Generated from the flag definitions by `lfeval doc` (do not edit by \

@@ -364,3 +364,66 @@ fn a_scene_without_ground_truth_is_named_and_one_with_a_broken_ground_truth_refu
         "{err}"
     );
 }
+
+/// `lfeval corrupt` then `lfeval robustness`: every copy keeps the ground truth byte for byte,
+/// the noise has its σ and repeats with its seed, and the ground truth scored on every copy
+/// (as a method) makes a table of zeros.
+#[test]
+fn corrupted_copies_and_the_robustness_table() {
+    let tmp = tempfile::tempdir().unwrap();
+    let root = tmp.path();
+    let ds = root.join("dataset");
+    write_scene(&ds.join("val/scene_0000"), 1);
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let corrupt = |out: &Path, seed: &str| {
+        lfeval(&["-q", "corrupt", &s(&ds), "--out", &s(out), "--seed", seed]);
+    };
+    let (a, b, c) = (root.join("a"), root.join("b"), root.join("c"));
+    corrupt(&a, "3");
+    corrupt(&b, "3");
+    corrupt(&c, "4");
+    let read = |p: &Path| std::fs::read(p).unwrap();
+    let scene = |copy: &Path, name: &str| copy.join(name).join("val/scene_0000");
+    let view = "input_Cam040.png";
+    let noisy = scene(&a, "noise_10").join(view);
+    assert_eq!(read(&noisy), read(&scene(&b, "noise_10").join(view)));
+    assert_ne!(read(&noisy), read(&scene(&c, "noise_10").join(view)));
+    for gt in ["gt_disp_lowres.pfm", "modes.exr", "parameters.cfg"] {
+        let original = read(&ds.join("val/scene_0000").join(gt));
+        assert_eq!(read(&scene(&a, "jpeg_30").join(gt)), original, "{gt}");
+    }
+    // The σ of the added noise, away from the clipped ends of the range.
+    let pixels = |p: &Path| image::open(p).unwrap().to_rgb8().into_raw();
+    let (clean, noise) = (pixels(&scene(&a, "clean").join(view)), pixels(&noisy));
+    let diffs: Vec<f64> = (clean.iter().zip(&noise))
+        .filter(|(c, _)| (40..=215).contains(*c))
+        .map(|(&c, &n)| n as f64 - c as f64)
+        .collect();
+    let sd = (diffs.iter().map(|d| d * d).sum::<f64>() / diffs.len() as f64).sqrt();
+    assert!((sd - 10.0).abs() < 0.6, "σ {sd}");
+
+    let truth = root.join("truth");
+    for entry in std::fs::read_dir(&a).unwrap() {
+        let copy = entry.unwrap().path();
+        if copy.is_dir() {
+            let name = copy.file_name().unwrap().to_str().unwrap().to_string();
+            lfeval(&["-q", "truth", &s(&copy), "--out", &s(&truth.join(name))]);
+        }
+    }
+    let report = root.join("robustness");
+    let table = lfeval(&["-q", "robustness", &s(&a), &s(&truth), "--out", &s(&report)]);
+    assert!(table.contains("| noise_10 | 0.000 |"), "{table}");
+    let json: Value = serde_json::from_slice(&read(&report.join("robustness.json"))).unwrap();
+    let rows = json["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 12);
+    assert!(
+        rows.iter().all(|r| r["scores"][0]["badpix_007"] == 0.0),
+        "{json}"
+    );
+    assert!(
+        std::fs::metadata(report.join("robustness.png"))
+            .unwrap()
+            .len()
+            > 1000
+    );
+}
