@@ -1,8 +1,12 @@
 //! Photometric augmentations of the thesis (§5.3.1): a rotation of the colours in RGB space and
-//! random brightness and contrast. The geometric ones (EPI shift, 90° rotation) live with the
-//! geometry in [`lfdata::stacks`] and [`lfdata::lightfield`].
+//! random brightness and contrast; and, not in the thesis, the degradations of a real camera
+//! ([`Degrade`]: blur and sensor noise), so that a net trained on clean rendered views keeps
+//! working on noisy captured ones. The geometric augmentations (EPI shift, 90° rotation,
+//! down-scaling) live with the geometry in [`lfdata::stacks`] and [`lfdata::lightfield`].
 
 use rand::{Rng, RngExt};
+use rand_distr::{Distribution, StandardNormal};
+use rand_pcg::Pcg32;
 
 use crate::config::{AugmentConfig, ColourAugment};
 
@@ -94,6 +98,110 @@ impl Photometric {
     }
 }
 
+/// One draw of the camera degradations, the same for every view of a sample (one lens, one
+/// sensor), with noise drawn independently per view, pixel and channel from `seed`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Degrade {
+    /// Standard deviation of the noise at mid-grey, in units of the `[0, 1]` pixel range.
+    pub noise: f32,
+    /// Share of the noise variance at mid-grey that grows with the value (shot noise): the
+    /// variance at value `v` is `noise² · (1 − shot + shot · v / 0.5)`.
+    pub shot: f32,
+    /// Gaussian blur σ, pixels (0: none).
+    pub blur: f32,
+    /// Seeds the noise streams (one per view).
+    pub seed: u64,
+}
+
+impl Degrade {
+    /// No degradation.
+    pub const NONE: Degrade = Degrade {
+        noise: 0.0,
+        shot: 0.0,
+        blur: 0.0,
+        seed: 0,
+    };
+
+    /// A random draw under `cfg`; draws nothing from `rng` when both degradations are off, so
+    /// configurations without them train exactly as before they existed.
+    pub fn random(cfg: &AugmentConfig, rng: &mut impl Rng) -> Self {
+        if cfg.noise[1] <= 0.0 && cfg.blur[1] <= 0.0 {
+            return Self::NONE;
+        }
+        let mut within = |[lo, hi]: [f32; 2]| {
+            if lo < hi {
+                rng.random_range(lo..=hi)
+            } else {
+                lo
+            }
+        };
+        let (noise, blur) = (within(cfg.noise), within(cfg.blur));
+        Self {
+            noise,
+            shot: cfg.noise_shot,
+            blur,
+            seed: rng.random(),
+        }
+    }
+
+    /// [`Degrade::apply`] to every view present of a light field's `views` (RGB interleaved,
+    /// `width` pixels a row), each with its index as its noise stream.
+    pub fn apply_all(&self, views: &mut [Option<Vec<f32>>], width: usize) {
+        for (index, view) in views.iter_mut().enumerate() {
+            if let Some(rgb) = view {
+                self.apply(rgb, width, index);
+            }
+        }
+    }
+
+    /// Blurs, then adds noise to, view number `index` of a sample: `rgb` interleaved,
+    /// `width` pixels a row.
+    pub fn apply(&self, rgb: &mut [f32], width: usize, index: usize) {
+        if self.blur > 0.0 {
+            gaussian_blur(rgb, width, self.blur);
+        }
+        if self.noise > 0.0 {
+            let mut rng = Pcg32::new(self.seed, index as u64);
+            let (constant, per_value) = (1.0 - self.shot, self.shot / 0.5);
+            for v in rgb.iter_mut() {
+                let variance = constant + per_value * v.max(0.0);
+                let z: f32 = StandardNormal.sample(&mut rng);
+                *v += self.noise * variance.sqrt() * z;
+            }
+        }
+    }
+}
+
+/// Separable Gaussian blur of standard deviation `sigma` pixels over an RGB-interleaved image
+/// `width` pixels wide, the kernel cut at 3σ and edge pixels repeated.
+pub fn gaussian_blur(rgb: &mut [f32], width: usize, sigma: f32) {
+    let height = rgb.len() / (3 * width.max(1));
+    let radius = (3.0 * sigma).ceil() as isize;
+    let weights: Vec<f32> = (-radius..=radius)
+        .map(|d| (-0.5 * (d as f32 / sigma).powi(2)).exp())
+        .collect();
+    let total: f32 = weights.iter().sum();
+    let kernel: Vec<f32> = weights.iter().map(|w| w / total).collect();
+    let pass = |src: &[f32], step: (isize, isize)| -> Vec<f32> {
+        let mut out = vec![0.0; src.len()];
+        for y in 0..height as isize {
+            for x in 0..width as isize {
+                let i = 3 * (y as usize * width + x as usize);
+                for (k, w) in kernel.iter().enumerate() {
+                    let d = k as isize - radius;
+                    let sx = (x + d * step.0).clamp(0, width as isize - 1) as usize;
+                    let sy = (y + d * step.1).clamp(0, height as isize - 1) as usize;
+                    let j = 3 * (sy * width + sx);
+                    (0..3).for_each(|c| out[i + c] += w * src[j + c]);
+                }
+            }
+        }
+        out
+    };
+    let rows = pass(rgb, (1, 0));
+    rgb.copy_from_slice(&pass(&rows, (0, 1)));
+}
+
 /// A random colour mix whose rows and columns each sum to 1 and whose entries are ≥ 0: a
 /// random convex combination of the six 3×3 permutation matrices (every such matrix is one,
 /// Birkhoff–von Neumann). Grey stays grey, and the mean colour of an image is preserved in
@@ -180,6 +288,84 @@ mod tests {
             v.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-6),
             "{v:?}"
         );
+    }
+
+    /// A flat patch gets noise of the drawn σ at mid-grey, a variance growing with the value by
+    /// the shot share, independent streams per view, and the same values for the same seed.
+    #[test]
+    fn noise_has_the_drawn_statistics() {
+        let d = Degrade {
+            noise: 0.02,
+            shot: 0.5,
+            ..Degrade::NONE
+        };
+        let stats = |value: f32, index: usize| {
+            let mut v = vec![value; 3 * 128 * 128];
+            d.apply(&mut v, 128, index);
+            let n = v.len() as f64;
+            let mean = v.iter().map(|&x| x as f64).sum::<f64>() / n;
+            let var = v.iter().map(|&x| (x as f64 - mean).powi(2)).sum::<f64>() / n;
+            (mean, var, v)
+        };
+        let n = (3 * 128 * 128) as f64;
+        // At 0.1 the variance is σ² · (0.5 + 0.5 · 0.1 / 0.5) = 0.6 σ².
+        for (value, want) in [(0.5, 0.02f64 * 0.02), (0.1, 0.02f64 * 0.02 * 0.6)] {
+            let (mean, var, _) = stats(value, 0);
+            assert!(
+                (mean - value as f64).abs() < 5.0 * (want / n).sqrt(),
+                "{mean}"
+            );
+            assert!(
+                (var / want - 1.0).abs() < 5.0 * (2.0 / n).sqrt(),
+                "{var} vs {want}"
+            );
+        }
+        assert_eq!(stats(0.5, 3).2, stats(0.5, 3).2);
+        assert_ne!(stats(0.5, 3).2, stats(0.5, 4).2);
+    }
+
+    /// Blurring keeps a flat image and the sum, and a single bright pixel spreads into the
+    /// sampled Gaussian: its centre row holds the `exp(-d²/2σ²)` ratios.
+    #[test]
+    fn blur_spreads_a_point_as_a_gaussian() {
+        let w = 21;
+        let mut flat = vec![0.3f32; 3 * w * w];
+        gaussian_blur(&mut flat, w, 1.5);
+        assert!(flat.iter().all(|v| (v - 0.3).abs() < 1e-6));
+        let mut point = vec![0.0f32; 3 * w * w];
+        point[3 * (10 * w + 10)] = 1.0;
+        gaussian_blur(&mut point, w, 1.5);
+        let sum: f32 = point.iter().sum();
+        assert!((sum - 1.0).abs() < 1e-5, "{sum}");
+        let at = |x: usize| point[3 * (10 * w + x)];
+        for d in 1..4 {
+            let ratio = at(10 + d) / at(10);
+            let want = (-((d * d) as f32) / (2.0 * 1.5 * 1.5)).exp();
+            assert!((ratio - want).abs() < 1e-5, "{d}: {ratio} vs {want}");
+            assert_eq!(at(10 + d), at(10 - d));
+        }
+        assert_eq!(point[3 * (10 * w + 10) + 1], 0.0, "channels stay apart");
+    }
+
+    /// Draws stay in their ranges; with both degradations off nothing is drawn from the stream.
+    #[test]
+    fn degrade_draws() {
+        let cfg = AugmentConfig {
+            noise: [0.0, 0.04],
+            blur: [0.0, 1.0],
+            ..AugmentConfig::default()
+        };
+        let mut rng = rand_pcg::Pcg32::new(1, 2);
+        for _ in 0..100 {
+            let d = Degrade::random(&cfg, &mut rng);
+            assert!((0.0..=0.04).contains(&d.noise) && (0.0..=1.0).contains(&d.blur));
+        }
+        let (mut a, mut b) = (rand_pcg::Pcg32::new(1, 2), rand_pcg::Pcg32::new(1, 2));
+        assert_eq!(
+            Degrade::random(&AugmentConfig::default(), &mut a),
+            Degrade::NONE
+        );
+        assert_eq!(a.random::<u64>(), b.random::<u64>());
     }
 
     #[test]

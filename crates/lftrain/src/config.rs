@@ -175,6 +175,16 @@ pub struct AugmentConfig {
     pub brightness: f32,
     /// ... and a contrast factor in `[1 - contrast, 1 + contrast]` about mid-grey (0: off).
     pub contrast: f32,
+    /// Sensor noise (not in the thesis): a σ per sample drawn from this range, in units of
+    /// the `[0, 1]` pixel range (0.02 ≈ 5/255), added independently per view, pixel and
+    /// channel after the colour augmentation. `[0, 0]`: off.
+    pub noise: [f32; 2],
+    /// The share of that noise's variance at mid-grey that is shot noise, growing with the
+    /// value (variance `σ² · (1 − s + s · v / 0.5)` at value `v`); 0: the same everywhere.
+    pub noise_shot: f32,
+    /// Optical blur (not in the thesis): a Gaussian σ in pixels per sample, drawn from this
+    /// range, the same for every view, applied before the noise. `[0, 0]`: off.
+    pub blur: [f32; 2],
 }
 
 /// The random colour matrix of a sample.
@@ -201,6 +211,9 @@ impl Default for AugmentConfig {
             contrast_scale: [0.1, 1.9],
             brightness: 0.0,
             contrast: 0.0,
+            noise: [0.0, 0.0],
+            noise_shot: 0.5,
+            blur: [0.0, 0.0],
         }
     }
 }
@@ -758,6 +771,16 @@ impl TrainConfig {
         {
             bail!(
                 "augment.brightness_scale and contrast_scale must be [min, max] ranges of factors ≥ 0"
+            );
+        }
+        if [a.noise, a.blur]
+            .iter()
+            .any(|[lo, hi]| !(lo.is_finite() && hi.is_finite() && 0.0 <= *lo && lo <= hi))
+            || !(a.noise[1] <= 1.0 && a.blur[1] <= 16.0 && (0.0..=1.0).contains(&a.noise_shot))
+        {
+            bail!(
+                "augment.noise must be a [min, max] range within [0, 1], augment.blur one \
+                 within [0, 16] px, and augment.noise_shot lie in [0, 1]"
             );
         }
         if !(0.0..1.0).contains(&self.texture_threshold) || self.texture_window.is_multiple_of(2) {

@@ -5,7 +5,7 @@ use lfdata::lightfield::{crop_plane, rotate_plane};
 use lfdata::stacks::{Direction, Region};
 use rand::{Rng, RngExt};
 
-use crate::augment::Photometric;
+use crate::augment::{Degrade, Photometric};
 use crate::config::AugmentConfig;
 use crate::input::StackInput;
 use crate::mask::inside_border;
@@ -24,6 +24,8 @@ pub struct Draw {
     pub shift: f32,
     /// Colour, brightness and contrast.
     pub photometric: Photometric,
+    /// Blur and sensor noise.
+    pub degrade: Degrade,
 }
 
 impl Draw {
@@ -63,6 +65,7 @@ impl Draw {
             },
             shift,
             photometric: Photometric::random(cfg, rng),
+            degrade: Degrade::random(cfg, rng),
         }
     }
 }
@@ -127,6 +130,8 @@ pub fn make_sample(
     for view in lf.views.iter_mut().flatten() {
         draw.photometric.apply(view, 1, pivot);
     }
+    // After the colours, as a camera's noise comes after the scene's light.
+    draw.degrade.apply_all(&mut lf.views, lf.width);
     let stacks = Direction::ALL.map(|dir| input.planes(&lf, dir, region, draw.shift));
     let (disparity, mut eta) = target_planes(&scene.targets, (x0, y0), patch, draw);
     let region = loss_region(scene, (x0, y0), patch, draw, border);

@@ -50,7 +50,9 @@ pub fn make_shift_sample(
     let (m, k) = (margin as isize, draw.scale.max(1));
     let side = patch + 2 * margin;
     let corner = (x0 - m * k as isize, y0 - m * k as isize);
-    let lf = scene.lf.crop(corner, (side, side), k).rotate(draw.turns);
+    let mut lf = scene.lf.crop(corner, (side, side), k).rotate(draw.turns);
+    // Before the colours here, which apply to the extracted stacks.
+    draw.degrade.apply_all(&mut lf.views, side);
     let inside = inside_scene(scene, corner, side, k, draw.turns);
     let region = Region {
         x0: margin,
@@ -209,7 +211,7 @@ impl ShiftBatch {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::augment::Photometric;
+    use crate::augment::{Degrade, Photometric};
     use crate::config::TrainConfig;
     use crate::synthetic::TwoPlanes;
 
@@ -227,6 +229,7 @@ mod tests {
             turns: 0,
             shift,
             photometric: Photometric::IDENTITY,
+            degrade: Degrade::NONE,
         }
     }
 

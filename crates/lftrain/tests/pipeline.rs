@@ -3,7 +3,7 @@
 
 use lfdata::lightfield::{LightField, rotate_plane};
 use lfdata::stacks::{Direction, Region, extract};
-use lftrain::augment::Photometric;
+use lftrain::augment::{Degrade, Photometric};
 use lftrain::config::AugmentConfig;
 use lftrain::input::StackInput;
 use lftrain::sample::{Draw, make_sample};
@@ -69,6 +69,7 @@ fn rotated_samples_match_samples_of_the_rendered_rotation() {
             turns,
             shift: 0.75,
             photometric: Photometric::IDENTITY,
+            degrade: Degrade::NONE,
         };
         // The whole image as the crop: rotating it is rotating the scene.
         let a = make_sample(&original, &draw(turns), 20, 0, &StackInput::Views);
@@ -135,6 +136,7 @@ fn shifting_by_the_disparity_aligns_the_views_and_zeroes_the_target() {
         turns: 0,
         shift: d,
         photometric: Photometric::IDENTITY,
+        degrade: Degrade::NONE,
     };
     let sample = make_sample(&scene, &draw, 16, 0, &StackInput::Views);
     assert!(sample.disparity.iter().all(|t| t.abs() < 1e-6));
@@ -169,6 +171,7 @@ fn downscaling_halves_the_disparity_of_views_and_targets() {
         turns: 0,
         shift,
         photometric: Photometric::IDENTITY,
+        degrade: Degrade::NONE,
     };
     let sample = make_sample(&scene, &draw(d / 2.0), 8, 0, &StackInput::Views);
     assert!(
