@@ -220,7 +220,7 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
         };
         write("reference", &reference)?;
         let gt = a.gt.as_ref().expect("the reference has GT");
-        let disparity: Vec<f32> = (gt.hci_depth.iter())
+        let disparity: Vec<f32> = (gt.hci.depth.iter())
             .map(|&z| cam.disparity(z as f64) as f32)
             .collect();
         // The residual of two converged views: its floor, from resampling alone (texture detail

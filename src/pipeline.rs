@@ -270,7 +270,9 @@ pub fn render_scene(
             let images = GtImages {
                 modes: &gt.modes,
                 colors: &gt.colors,
-                hci_depth: &gt.hci_depth,
+                surfaces: &gt.surfaces,
+                hci: &gt.hci,
+                valid: &gt.valid,
             };
             writer.write_gt(view, view == center, per_view, &desc.camera, &images)?;
         }
@@ -289,11 +291,12 @@ fn scene_stats(
 ) -> SceneStats {
     let gt = out.gt.as_ref().expect("centre view has GT");
     let hci_disp: Vec<f32> = gt
-        .hci_depth
+        .hci
+        .depth
         .iter()
         .map(|&z| desc.camera.disparity(z as f64) as f32)
         .collect();
-    let mut s = SceneStats::from_gt(&gt.modes, &hci_disp);
+    let mut s = SceneStats::from_gt(&gt.modes, &hci_disp, &gt.valid);
     s.baseline_mm = desc.camera.baseline_m * 1000.0;
     s.focus_distance_m = desc.camera.focus_distance_m;
     s.depth_range_m = [desc.slices.z_near, desc.slices.z_far];

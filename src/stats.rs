@@ -3,6 +3,7 @@
 //! Nothing here depends on time or threads, so `stats.json` is as reproducible as the images;
 //! render timings go to the dataset's `timings.jsonl` instead.
 
+use crate::appearance::{ImageStats, quantiles};
 use crate::scene::PlacementReport;
 use lfformat::ModeMap;
 use serde::{Deserialize, Serialize};
@@ -30,6 +31,9 @@ pub struct SceneStats {
     pub disparity_histogram: Vec<f64>,
     /// Mean of Σ η over pixels (1 in a closed room).
     pub mean_eta_sum: f64,
+    /// Fraction of pixels set in `valid_mask.png`.
+    #[serde(default)]
+    pub valid_fraction: f64,
     pub baseline_mm: f64,
     pub focus_distance_m: f64,
     pub depth_range_m: [f64; 2],
@@ -40,11 +44,15 @@ pub struct SceneStats {
     /// Pieces placed and rejected by the built-in generator (absent for imported scenes).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub placement: Option<PlacementReport>,
+    /// Local contrast, flat share, mean luminance and noise of the written centre view
+    /// ([`crate::appearance`]; absent in older datasets).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub appearance: Option<ImageStats>,
 }
 
 impl SceneStats {
     /// Computes the ground-truth figures; camera and scene fields are filled by the caller.
-    pub fn from_gt(modes: &ModeMap, hci_disparity: &[f32]) -> Self {
+    pub fn from_gt(modes: &ModeMap, hci_disparity: &[f32], valid: &[bool]) -> Self {
         let pixels = (modes.width * modes.height).max(1) as f64;
         let mut counts = vec![0u64; modes.max_modes() + 1];
         let (mut multimodal, mut eta_sum) = (0u64, 0.0f64);
@@ -80,6 +88,7 @@ impl SceneStats {
             hci_disparity_range: hci,
             disparity_histogram: hist,
             mean_eta_sum: eta_sum / pixels,
+            valid_fraction: valid.iter().filter(|&&v| v).count() as f64 / pixels,
             baseline_mm: 0.0,
             focus_distance_m: 0.0,
             depth_range_m: [0.0, 0.0],
@@ -87,6 +96,7 @@ impl SceneStats {
             triangles: 0,
             date: String::new(),
             placement: None,
+            appearance: None,
         }
     }
 }
@@ -98,6 +108,9 @@ pub struct DatasetSummary {
     /// [min, median, max] over scenes.
     pub multimodal_fraction: [f64; 3],
     pub two_mode_fraction: [f64; 3],
+    /// Fraction of pixels in `valid_mask.png`.
+    #[serde(default)]
+    pub valid_fraction: [f64; 3],
     pub exposure: [f64; 3],
     /// Pixels with exactly k modes, summed over scenes.
     pub mode_count_histogram: Vec<u64>,
@@ -105,6 +118,33 @@ pub struct DatasetSummary {
     pub disparity_range: [f64; 2],
     pub objects_placed: u64,
     pub objects_rejected: u64,
+    /// `[min, q25, median, q75, max]` over the scenes that have them of each centre-view
+    /// appearance figure ([`crate::appearance`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub appearance: Option<AppearanceSummary>,
+}
+
+/// Quantiles over scenes of the [`ImageStats`] figures.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AppearanceSummary {
+    pub local_contrast: [f64; 5],
+    pub flat_share: [f64; 5],
+    pub mean_luminance: [f64; 5],
+    pub noise: [f64; 5],
+}
+
+impl AppearanceSummary {
+    /// The quantiles over `scenes`' figures, `None` when none has them.
+    pub fn new(scenes: &[SceneStats]) -> Option<Self> {
+        let figures: Vec<ImageStats> = scenes.iter().filter_map(|s| s.appearance).collect();
+        let q = |f: fn(&ImageStats) -> f64| quantiles(&figures.iter().map(f).collect::<Vec<_>>());
+        (!figures.is_empty()).then(|| Self {
+            local_contrast: q(|s| s.local_contrast),
+            flat_share: q(|s| s.flat_share),
+            mean_luminance: q(|s| s.mean_luminance),
+            noise: q(|s| s.noise),
+        })
+    }
 }
 
 impl DatasetSummary {
@@ -132,6 +172,7 @@ impl DatasetSummary {
             scenes: scenes.len(),
             multimodal_fraction: spread(&|s| s.multimodal_fraction),
             two_mode_fraction: spread(&|s| s.two_mode_fraction),
+            valid_fraction: spread(&|s| s.valid_fraction),
             exposure: spread(&|s| s.exposure as f64),
             mode_count_histogram: hist,
             disparity_range: scenes
@@ -141,6 +182,7 @@ impl DatasetSummary {
                 }),
             objects_placed: placed,
             objects_rejected: rejected,
+            appearance: AppearanceSummary::new(scenes),
         }
     }
 }
@@ -161,7 +203,7 @@ mod tests {
         };
         map.push_pixel(&[m(1.0, 0.4), m(-1.0, 0.6)]);
         map.push_pixel(&[m(0.0, 1.0)]);
-        let s = SceneStats::from_gt(&map, &[0.5, f32::NAN]);
+        let s = SceneStats::from_gt(&map, &[0.5, f32::NAN], &[false, true]);
         assert_eq!(s.multimodal_fraction, 0.5);
         assert_eq!(s.two_mode_fraction, 0.5);
         assert_eq!(s.mode_count_histogram, vec![0, 1, 1]);
@@ -169,8 +211,10 @@ mod tests {
         assert_eq!(s.hci_disparity_range, [0.5, 0.5]);
         assert!((s.disparity_histogram.iter().sum::<f64>() - 1.0).abs() < 1e-6);
         assert!((s.mean_eta_sum - 1.0).abs() < 1e-6);
+        assert_eq!(s.valid_fraction, 0.5);
         let summary = DatasetSummary::new(&[s.clone(), s]);
         assert_eq!(summary.mode_count_histogram, vec![0, 2, 2]);
         assert_eq!(summary.multimodal_fraction, [0.5; 3]);
+        assert_eq!(summary.valid_fraction, [0.5; 3]);
     }
 }

@@ -315,7 +315,7 @@ fn assert_every_pixel(cam: &LightFieldCamera, g: &ViewGt, want: &[(f64, f32)], t
 
 /// Every pixel's HCI depth (pixel-centre ray) is `depth`.
 fn assert_hci(g: &ViewGt, depth: f64) {
-    for (i, &got) in g.hci_depth.iter().enumerate() {
+    for (i, &got) in g.hci.depth.iter().enumerate() {
         let rel = (got as f64 - depth).abs() / depth;
         assert!(rel < 1e-4, "pixel {i}: hci depth {got} vs {depth}");
     }

@@ -144,7 +144,7 @@ fn opaque_plane_has_exact_disparity_and_the_cameras_field_of_view() {
     for (x, y, modes) in each_pixel(&g) {
         assert_modes(modes, &[(2.0, 1.0)], f, 1e-6, &format!("pixel ({x}, {y})"));
     }
-    assert!(g.hci_depth.iter().all(|&z| (z - 2.0).abs() < 2e-6));
+    assert!(g.hci.depth.iter().all(|&z| (z - 2.0).abs() < 2e-6));
 }
 
 #[test]
@@ -163,7 +163,7 @@ fn blend_pane_alpha_is_factor_times_texture_and_gives_eta() {
             &format!("pixel ({x}, {y})"),
         );
     }
-    assert!(g.hci_depth.iter().all(|&z| (z - 3.5).abs() < 4e-6));
+    assert!(g.hci.depth.iter().all(|&z| (z - 3.5).abs() < 4e-6));
 }
 
 #[test]
@@ -197,7 +197,7 @@ fn node_hierarchy_with_rotation_scale_and_matrix_places_the_quad() {
     let half = f / 3.0;
     let g = l.gt(1);
     let (mut inside, mut outside) = (0, 0);
-    for (i, &z) in g.hci_depth.iter().enumerate() {
+    for (i, &z) in g.hci.depth.iter().enumerate() {
         let (x, y) = ((i % 32) as f64 + 0.5, (i / 32) as f64 + 0.5);
         let covered = (x - 16.0).abs() < half && (y - 16.0).abs() < half;
         let want = if covered { 3.0 } else { 6.0 };

@@ -249,7 +249,7 @@ fn the_ground_truth_is_the_same_with_shared_and_independent_shading() {
         let a = h.render(view, &s, true).gt.unwrap();
         let b = h.render_shared(view, &s, &cache, true).gt.unwrap();
         assert!(a.modes == b.modes, "view {view}: modes differ");
-        assert_eq!(a.hci_depth, b.hci_depth, "view {view}: HCI depth differs");
+        assert_eq!(a.hci.depth, b.hci.depth, "view {view}: HCI depth differs");
         let two = a.modes.pixels().filter(|m| m.len() == 2).count();
         assert!(
             two > 100,

@@ -4,6 +4,7 @@
 //! hidden temporary folder beside its final place and renamed when complete, so a killed run or a
 //! full disk never leaves a half-written scene under the final name.
 
+pub mod gt_files;
 pub mod images;
 pub mod preview;
 pub mod scene_dir;

@@ -7,19 +7,22 @@
 //! The temporary folders `.NAME.partial` and `.NAME.old` carry a marker file while they exist,
 //! and a folder of either name without it is the user's: refused, never removed.
 
+use super::gt_files::{
+    write_depth_maps, write_ids_json, write_objectids_highres, write_surface_maps, write_valid,
+};
 use super::images::{ToneCurve, write_linear_exr, write_png};
 use crate::camera::LightFieldCamera;
+use crate::render::view::HciLayer;
 use crate::scene::SceneDesc;
 use crate::stats::SceneStats;
 use anyhow::{Context, Result, bail};
 use glam::Vec3;
 use lfformat::lock::Lock;
 use lfformat::manifest::{FileEntry, sha256_file};
-use lfformat::modes::write_modes_exr;
+use lfformat::modes::write_modes_exr_with_surfaces;
 use lfformat::mpi::{LOADER_LAYERS, Mpi, write_mpi_npz};
 use lfformat::params::hci_disp_bounds;
-use lfformat::pfm::{FloatImage, write_pfm};
-use lfformat::{HciParameters, ModeMap};
+use lfformat::{HciParameters, ModeMap, ModeSurface};
 use std::fs;
 use std::path::{Path, PathBuf};
 
@@ -31,6 +34,8 @@ pub struct SceneWriter {
     old_dir: PathBuf,
     write_exr: bool,
     tone_curve: ToneCurve,
+    /// High-resolution GT written at this many pixels per pixel (`depth_map_scale`), if any.
+    highres_scale: Option<u32>,
     /// Held until the folder is published (or the writer is dropped on an error).
     _lock: Lock,
 }
@@ -40,8 +45,12 @@ pub struct GtImages<'a> {
     pub modes: &'a ModeMap,
     /// Linear colour per mode, in `modes` storage order.
     pub colors: &'a [[f32; 3]],
-    /// HCI single-valued planar depth per pixel (NaN: none).
-    pub hci_depth: &'a [f32],
+    /// Normal and ids per mode, in `modes` storage order.
+    pub surfaces: &'a [ModeSurface],
+    /// The HCI single-valued layer: depth, normal and ids per pixel.
+    pub hci: &'a HciLayer,
+    /// Where the HCI disparity is trustworthy (`valid_mask.png`).
+    pub valid: &'a [bool],
 }
 
 impl SceneWriter {
@@ -70,6 +79,7 @@ impl SceneWriter {
             old_dir,
             write_exr,
             tone_curve,
+            highres_scale: None,
             _lock: lock,
         })
     }
@@ -117,30 +127,39 @@ impl SceneWriter {
         gt: &GtImages,
     ) -> Result<()> {
         let (w, h) = (gt.modes.width, gt.modes.height);
-        let depth = FloatImage::new(w, h, gt.hci_depth.to_vec());
-        let disp = FloatImage::new(
-            w,
-            h,
-            gt.hci_depth
-                .iter()
-                .map(|&z| cam.disparity(z as f64) as f32)
-                .collect(),
-        );
-        let mut suffixes = Vec::new();
         if is_center {
-            suffixes.push(String::new());
             write_mpi_npz(
                 &self.path("gt_mpi_lowres.npz"),
                 &Mpi::from_modes(gt.modes, Some(gt.colors), LOADER_LAYERS),
             )?;
         }
-        if per_view {
-            suffixes.push(format!("_Cam{view:03}"));
+        let disparity = |z: f32| cam.disparity(z as f64) as f32;
+        let dir = &self.tmp_dir;
+        for s in gt_suffixes(view, is_center, per_view) {
+            write_depth_maps(dir, "lowres", &s, gt.hci, disparity)?;
+            let modes = self.path(&format!("modes{s}.exr"));
+            write_modes_exr_with_surfaces(&modes, gt.modes, gt.surfaces)?;
+            write_surface_maps(dir, "lowres", &s, gt.hci)?;
+            write_valid(dir, &s, w, h, gt.valid)?;
         }
-        for s in &suffixes {
-            write_pfm(&self.path(&format!("gt_depth_lowres{s}.pfm")), &depth)?;
-            write_pfm(&self.path(&format!("gt_disp_lowres{s}.pfm")), &disp)?;
-            write_modes_exr(&self.path(&format!("modes{s}.exr")), gt.modes)?;
+        Ok(())
+    }
+
+    /// High-resolution GT of a view (`gt_depth_highres.pfm`, `gt_disp_highres.pfm`,
+    /// `objectids_highres.png`, named as [`Self::write_gt`] names the low-resolution files),
+    /// `scale` pixels per low-resolution pixel; `parameters.cfg` then says `depth_map_scale`.
+    pub fn write_highres(
+        &mut self,
+        (view, is_center, per_view): (u32, bool, bool),
+        cam: &LightFieldCamera,
+        layer: &HciLayer,
+        scale: u32,
+    ) -> Result<()> {
+        self.highres_scale = Some(scale);
+        let disparity = |z: f32| cam.disparity(z as f64) as f32;
+        for s in gt_suffixes(view, is_center, per_view) {
+            write_depth_maps(&self.tmp_dir, "highres", &s, layer, disparity)?;
+            write_objectids_highres(&self.tmp_dir, &s, layer)?;
         }
         Ok(())
     }
@@ -153,9 +172,13 @@ impl SceneWriter {
         stats: &SceneStats,
         root: &Path,
     ) -> Result<Vec<FileEntry>> {
-        let params = hci_parameters(desc, stats);
+        let mut params = hci_parameters(desc, stats);
+        if let Some(scale) = self.highres_scale {
+            params.depth_map_scale = scale as f64;
+        }
         params.write(&self.path("parameters.cfg"))?;
         write_json(&self.path("scene.json"), desc)?;
+        write_ids_json(&self.path("ids.json"), desc)?;
         write_json(&self.path("stats.json"), stats)?;
         self.publish()?;
         list_files(&self.final_dir, root)
@@ -183,6 +206,16 @@ impl SceneWriter {
         }
         Ok(())
     }
+}
+
+/// The name suffixes of a view's GT files: none for the centre view (HCI's names), `_CamNNN`
+/// for every view with per-view GT.
+fn gt_suffixes(view: u32, is_center: bool, per_view: bool) -> Vec<String> {
+    let centre = is_center.then(String::new);
+    centre
+        .into_iter()
+        .chain(per_view.then(|| format!("_Cam{view:03}")))
+        .collect()
 }
 
 /// The file that marks a folder as lfgen's own temporary one (a scene being written, or a
@@ -267,10 +300,11 @@ pub fn check_replaceable(dir: &Path) -> Result<()> {
 
 /// Whether `name` is one of the files [`SceneWriter`] writes.
 fn is_scene_file(name: &str) -> bool {
-    const FIXED: [&str; 4] = [
+    const FIXED: [&str; 5] = [
         "parameters.cfg",
         "scene.json",
         "stats.json",
+        "ids.json",
         "gt_mpi_lowres.npz",
     ];
     let per_view = |stem: &str, ext: &str| {
@@ -289,8 +323,17 @@ fn is_scene_file(name: &str) -> bool {
         .is_some_and(|n| n.len() == 3 && n.bytes().all(|b| b.is_ascii_digit()));
     FIXED.contains(&name)
         || view
-        || per_view("gt_depth_lowres", ".pfm")
-        || per_view("gt_disp_lowres", ".pfm")
+        || ["gt_depth_", "gt_disp_"].iter().any(|map| {
+            ["lowres", "highres"]
+                .iter()
+                .any(|res| per_view(&format!("{map}{res}"), ".pfm"))
+        })
+        || per_view("gt_normals_lowres", ".exr")
+        || ["objectids", "materialids", "classids"]
+            .iter()
+            .any(|map| per_view(&format!("{map}_lowres"), ".png"))
+        || per_view("objectids_highres", ".png")
+        || per_view("valid_mask", ".png")
         || per_view("modes", ".exr")
 }
 

@@ -12,6 +12,7 @@ pub mod console;
 pub mod dataset;
 pub mod error;
 pub mod files;
+pub mod gt_maps;
 pub mod lock;
 pub mod manifest;
 pub mod modes;
@@ -25,7 +26,7 @@ pub mod results;
 pub mod views;
 
 pub use error::{Error, Result};
-pub use modes::{Mode, ModeMap};
+pub use modes::{Mode, ModeMap, ModeSurface};
 pub use params::HciParameters;
 
 /// The rows (`row_len` elements each) of `data`, last row first.

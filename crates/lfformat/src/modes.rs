@@ -28,6 +28,37 @@ pub struct Mode {
     pub eta_exact: f32,
 }
 
+/// What surface a mode is: its geometric normal and its ids, one per mode beside the
+/// [`ModeMap`] (same storage order), so readers that want only depths never see them.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct ModeSurface {
+    /// Unit geometric (triangle) normal in the camera frame shared by every view: x right,
+    /// y up, z towards the camera; turned to face the camera (z > 0 seen head-on). NaN where
+    /// the mode has no surface (an unused slot).
+    pub normal: [f32; 3],
+    /// Object id: the object's index in `scene.json`'s `objects` plus 1 (0: none).
+    pub object: u32,
+    /// Material id: the index in `scene.json`'s `materials` plus 1 (0: none).
+    pub material: u32,
+    /// Semantic class id, named in the scene's `ids.json` (0: none).
+    pub class: u32,
+}
+
+impl ModeSurface {
+    /// No surface: NaN normal, ids 0 (unused slots, pixels that see nothing).
+    pub const NONE: Self = Self {
+        normal: [f32::NAN; 3],
+        object: 0,
+        material: 0,
+        class: 0,
+    };
+}
+
+/// Channel suffixes of a [`ModeSurface`]: three float normal components, then three u32 ids.
+const SURFACE_FIELDS: [&str; 6] = [
+    "normal.X", "normal.Y", "normal.Z", "object", "material", "class",
+];
+
 /// Channel suffixes in the order of [`Mode::to_array`].
 const FIELDS: [&str; 4] = ["disparity", "depth", "eta", "eta_exact"];
 
@@ -184,24 +215,30 @@ fn to_offset(n: usize) -> u32 {
 /// # Panics
 /// If `map` is incomplete.
 pub fn write_modes_exr(path: &Path, map: &ModeMap) -> Result<()> {
+    write_modes(path, map, None)
+}
+
+/// [`write_modes_exr`] plus each mode's surface: float32 `mode{k}.normal.X|Y|Z` and uint32
+/// `mode{k}.object|material|class` (unused slots: NaN normal, ids 0). The depth channels are
+/// the same as without them, so readers of depths alone read the file unchanged.
+///
+/// # Panics
+/// If `map` is incomplete or `surfaces` is not one per mode.
+pub fn write_modes_exr_with_surfaces(
+    path: &Path,
+    map: &ModeMap,
+    surfaces: &[ModeSurface],
+) -> Result<()> {
+    assert_eq!(surfaces.len(), map.total_modes(), "one surface per mode");
+    write_modes(path, map, Some(surfaces))
+}
+
+fn write_modes(path: &Path, map: &ModeMap, surfaces: Option<&[ModeSurface]>) -> Result<()> {
     assert!(map.is_complete(), "write_modes_exr: incomplete ModeMap");
-    let slots = map.slot_count();
-    let mut planes = vec![vec![0.0f32; map.width * map.height]; slots * FIELDS.len()];
-    for (i, modes) in map.pixels().enumerate() {
-        for k in 0..slots {
-            let values = modes.get(k).copied().unwrap_or(UNUSED).to_array();
-            for (f, v) in values.into_iter().enumerate() {
-                planes[k * FIELDS.len() + f][i] = v;
-            }
-        }
+    let mut channels = mode_channels(map);
+    if let Some(surfaces) = surfaces {
+        channels.extend(surface_channels(map, surfaces));
     }
-    let channels: Vec<_> = planes
-        .into_iter()
-        .enumerate()
-        .map(|(index, plane)| {
-            AnyChannel::new(channel_name(index).as_str(), FlatSamples::F32(plane))
-        })
-        .collect();
     let layer = Layer::new(
         (map.width, map.height),
         LayerAttributes::default(),
@@ -216,11 +253,71 @@ pub fn write_modes_exr(path: &Path, map: &ModeMap) -> Result<()> {
     crate::files::write_file(path, bytes.get_ref())
 }
 
+/// The `mode{k}.{field}` channels of `map`.
+fn mode_channels(map: &ModeMap) -> Vec<AnyChannel<FlatSamples>> {
+    let slots = map.slot_count();
+    let mut planes = vec![vec![0.0f32; map.width * map.height]; slots * FIELDS.len()];
+    for (i, modes) in map.pixels().enumerate() {
+        for k in 0..slots {
+            let values = modes.get(k).copied().unwrap_or(UNUSED).to_array();
+            for (f, v) in values.into_iter().enumerate() {
+                planes[k * FIELDS.len() + f][i] = v;
+            }
+        }
+    }
+    let named = planes.into_iter().enumerate();
+    named
+        .map(|(index, plane)| {
+            AnyChannel::new(channel_name(index).as_str(), FlatSamples::F32(plane))
+        })
+        .collect()
+}
+
+/// The `mode{k}.normal.*` and id channels of `surfaces` (in `map`'s storage order).
+fn surface_channels(map: &ModeMap, surfaces: &[ModeSurface]) -> Vec<AnyChannel<FlatSamples>> {
+    let (slots, pixels) = (map.slot_count(), map.width * map.height);
+    let mut normals = vec![vec![0.0f32; pixels]; slots * 3];
+    let mut ids = vec![vec![0u32; pixels]; slots * 3];
+    let mut next = 0;
+    for (i, modes) in map.pixels().enumerate() {
+        for k in 0..slots {
+            let s = match k < modes.len() {
+                true => surfaces[next + k],
+                false => ModeSurface::NONE,
+            };
+            for c in 0..3 {
+                normals[k * 3 + c][i] = s.normal[c];
+            }
+            for (c, id) in [s.object, s.material, s.class].into_iter().enumerate() {
+                ids[k * 3 + c][i] = id;
+            }
+        }
+        next += modes.len();
+    }
+    let name = |k: usize, f: usize| format!("mode{k}.{}", SURFACE_FIELDS[f]);
+    let floats = normals
+        .into_iter()
+        .enumerate()
+        .map(|(j, p)| AnyChannel::new(name(j / 3, j % 3).as_str(), FlatSamples::F32(p)));
+    let uints = ids
+        .into_iter()
+        .enumerate()
+        .map(|(j, p)| AnyChannel::new(name(j / 3, 3 + j % 3).as_str(), FlatSamples::U32(p)));
+    floats.chain(uints).collect()
+}
+
 /// Reads a `modes.exr`; slots with `eta == 0` and `eta_exact == 0` are dropped.
 ///
 /// Channels are matched by name, not position: EXR stores them sorted alphabetically
 /// (`mode10` before `mode2`). Channels not named `mode{k}.{field}` are ignored.
 pub fn read_modes_exr(path: &Path) -> Result<ModeMap> {
+    Ok(read_modes_exr_with_surfaces(path)?.0)
+}
+
+/// [`read_modes_exr`] and each kept mode's [`ModeSurface`], in the map's storage order; `None`
+/// for a file written without surfaces. A file with some surface channels must have all six
+/// for every slot.
+pub fn read_modes_exr_with_surfaces(path: &Path) -> Result<(ModeMap, Option<Vec<ModeSurface>>)> {
     let image = exr::prelude::read()
         .no_deep_data()
         .largest_resolution_level()
@@ -231,19 +328,90 @@ pub fn read_modes_exr(path: &Path) -> Result<ModeMap> {
         .map_err(|e| exr_error(path, e))?;
     let layer = image.layer_data;
     let (width, height) = (layer.size.width(), layer.size.height());
-    let planes =
-        mode_planes(&layer.channel_data, width * height).map_err(|m| Error::format(path, m))?;
+    let channels = &layer.channel_data;
+    let planes = mode_planes(channels, width * height).map_err(|m| Error::format(path, m))?;
+    let slots = planes.len() / FIELDS.len();
+    let surface =
+        surface_planes(channels, width * height, slots).map_err(|m| Error::format(path, m))?;
     let mut map = ModeMap::new(width, height);
-    let mut modes = Vec::with_capacity(planes.len() / FIELDS.len());
+    let mut surfaces = surface.as_ref().map(|_| Vec::new());
+    let mut modes = Vec::with_capacity(slots);
     for i in 0..width * height {
         modes.clear();
-        let slots = planes
-            .chunks_exact(FIELDS.len())
-            .map(|p| Mode::from_array(std::array::from_fn(|f| p[f][i])));
-        modes.extend(slots.filter(|m| !m.is_unused()));
+        for (k, p) in planes.chunks_exact(FIELDS.len()).enumerate() {
+            let mode = Mode::from_array(std::array::from_fn(|f| p[f][i]));
+            if mode.is_unused() {
+                continue;
+            }
+            modes.push(mode);
+            if let (Some(out), Some(s)) = (surfaces.as_mut(), surface.as_ref()) {
+                out.push(s.at(k, i));
+            }
+        }
         map.push_pixel(&modes);
     }
-    Ok(map)
+    Ok((map, surfaces))
+}
+
+/// The surface channels of a `modes.exr`: per slot three normal planes and three id planes.
+struct SurfacePlanes {
+    normals: Vec<Vec<f32>>,
+    ids: Vec<Vec<u32>>,
+}
+
+impl SurfacePlanes {
+    fn at(&self, slot: usize, i: usize) -> ModeSurface {
+        let n = |c: usize| self.normals[slot * 3 + c][i];
+        let id = |c: usize| self.ids[slot * 3 + c][i];
+        ModeSurface {
+            normal: [n(0), n(1), n(2)],
+            object: id(0),
+            material: id(1),
+            class: id(2),
+        }
+    }
+}
+
+/// The surface planes of `slots` slots, or `None` when the file has no surface channel.
+fn surface_planes(
+    channels: &AnyChannels<FlatSamples>,
+    pixels: usize,
+    slots: usize,
+) -> std::result::Result<Option<SurfacePlanes>, String> {
+    let is_surface = |name: &str| {
+        let rest = name.strip_prefix("mode").and_then(|r| r.split_once('.'));
+        rest.is_some_and(|(_, field)| SURFACE_FIELDS.contains(&field))
+    };
+    if !channels
+        .list
+        .iter()
+        .any(|c| is_surface(&c.name.to_string()))
+    {
+        return Ok(None);
+    }
+    let find = |name: String| {
+        let channel = channels.list.iter().find(|c| c.name.to_string() == name);
+        let channel = channel.ok_or_else(|| format!("missing channel {name}"))?;
+        match channel.sample_data.len() == pixels {
+            true => Ok(&channel.sample_data),
+            false => Err(format!("channel {name} is subsampled")),
+        }
+    };
+    let mut planes = SurfacePlanes {
+        normals: Vec::new(),
+        ids: Vec::new(),
+    };
+    for k in 0..slots {
+        for (f, field) in SURFACE_FIELDS.iter().enumerate() {
+            let name = format!("mode{k}.{field}");
+            match (f < 3, find(name.clone())?) {
+                (true, samples) => planes.normals.push(samples.values_as_f32().collect()),
+                (false, FlatSamples::U32(ids)) => planes.ids.push(ids.clone()),
+                (false, _) => return Err(format!("channel {name} is not uint32")),
+            }
+        }
+    }
+    Ok(Some(planes))
 }
 
 /// The sample planes of all `mode{k}.*` channels in [`channel_name`] order, each `pixels` long.

@@ -18,9 +18,11 @@ pub mod lights;
 pub mod material;
 pub mod sampler;
 pub mod slices;
+pub mod valid;
 pub mod view;
 
 use crate::scene::assets::Assets;
+use crate::scene::labels::SceneClasses;
 use crate::scene::{MAX_TRIANGLES, SceneDesc};
 use anyhow::{Result, bail, ensure};
 use geometry::{Geometry, SceneTri};
@@ -37,6 +39,8 @@ pub struct RenderScene {
     pub lights: Lights,
     pub punctual_lights: Vec<PunctualLight>,
     pub environment: Vec3,
+    /// Semantic class id of each object ([`SceneClasses`]).
+    pub classes: Vec<u32>,
 }
 
 impl RenderScene {
@@ -65,6 +69,7 @@ impl RenderScene {
             Ok(())
         })?;
         let names: Vec<String> = desc.objects.iter().map(|o| o.name.clone()).collect();
+        let classes = SceneClasses::new(names.iter().map(String::as_str)).of_object;
         // In parallel: library textures are drawn into tiles here.
         let materials = desc
             .materials
@@ -79,6 +84,7 @@ impl RenderScene {
             lights,
             punctual_lights: desc.lights.iter().map(PunctualLight::new).collect(),
             environment: Vec3::from(desc.environment),
+            classes,
         })
     }
 }

@@ -6,9 +6,12 @@
 //! filter), and the slices are then composited front to back: `η_j = α_j Π_{k<j} (1 − α_k)`.
 //! `η_exact` sums `T·a` per hit (T the transmittance in front of it, per sample): the exact
 //! visible fraction that the over operator approximates when coverages are correlated.
+//!
+//! The same hits give each mode its surface: the over-weighted mean of the hits' normals, and
+//! the ids of the object with the largest over weight in the slice.
 
 use glam::Vec3;
-use lfformat::Mode;
+use lfformat::{Mode, ModeSurface};
 use serde::{Deserialize, Serialize};
 
 /// Which depth decides a hit's slice.
@@ -31,6 +34,31 @@ pub struct SliceHit {
     /// Radiance leaving the surface towards the camera, when every hit is shaded
     /// (`render.write_slices`); `None` otherwise.
     pub radiance: Option<Vec3>,
+    /// Unit geometric normal in the camera frame, facing the camera.
+    pub normal: Vec3,
+    pub ids: SurfaceIds,
+    /// Glass, or a coverage strictly between 0 and 1: what lies behind it is seen through it.
+    pub translucent: bool,
+}
+
+/// The ids of a hit's surface (see [`ModeSurface`]; 0: none).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SurfaceIds {
+    pub object: u32,
+    pub material: u32,
+    pub class: u32,
+}
+
+/// How many distinct objects a slice of one pixel tallies; a further one is not counted (five
+/// objects in one slice of one pixel are rare, and the largest is almost always among the
+/// first four met).
+const VOTES: usize = 4;
+
+/// An object's summed over weight in a slice.
+#[derive(Clone, Copy, Default)]
+struct Vote {
+    ids: SurfaceIds,
+    weight: f32,
 }
 
 /// Per-pixel slice accumulators, reused across pixels (no allocation per sample).
@@ -40,13 +68,18 @@ pub struct SliceAccumulator {
     exact: Vec<f32>,
     color: Vec<Vec3>,
     color_weight: Vec<f32>,
+    /// Over-weighted sum of the hits' normals, and the objects' weights, per slice.
+    normal: Vec<Vec3>,
+    votes: Vec<[Vote; VOTES]>,
+    /// Nearest depth of a translucent hit some sample saw (infinity: none).
+    translucent_z: f32,
     touched: Vec<u32>,
     marked: Vec<bool>,
     /// In-slice transmittance of the current sample, and the slices it touched.
     sample_t: Vec<f32>,
     sample_touched: Vec<u32>,
     /// The pixel's modes before sorting by depth.
-    pixel_modes: Vec<(Mode, [f32; 3])>,
+    pixel_modes: Vec<(Mode, [f32; 3], ModeSurface)>,
     samples: u32,
 }
 
@@ -64,6 +97,9 @@ impl SliceAccumulator {
             exact: vec![0.0; slices],
             color: vec![Vec3::ZERO; slices],
             color_weight: vec![0.0; slices],
+            normal: vec![Vec3::ZERO; slices],
+            votes: vec![[Vote::default(); VOTES]; slices],
+            translucent_z: f32::INFINITY,
             touched: Vec::with_capacity(slices),
             marked: vec![false; slices],
             sample_t: vec![1.0; slices],
@@ -93,6 +129,11 @@ impl SliceAccumulator {
             }
             let w = self.sample_t[k] * h.coverage;
             self.alpha_z[k] += w as f64 * h.z as f64;
+            self.normal[k] += h.normal * w;
+            vote(&mut self.votes[k], h.ids, w);
+            if h.translucent && transmittance > 0.0 {
+                self.translucent_z = self.translucent_z.min(h.z);
+            }
             if let Some(radiance) = h.radiance {
                 self.color[k] += radiance * w;
                 self.color_weight[k] += w;
@@ -119,16 +160,18 @@ impl SliceAccumulator {
     }
 
     /// Composites the pixel's slices front to back and appends its modes (η or η_exact above
-    /// `epsilon`) and their colours, sorted by depth; resets the accumulators for the next
-    /// pixel. (Slice order and depth order differ only where two surfaces of neighbouring
-    /// slices interleave inside one pixel, at creases.)
+    /// `epsilon`), their colours and surfaces, sorted by depth; resets the accumulators for
+    /// the next pixel and returns the nearest depth of a translucent hit a sample saw
+    /// (infinity: none). (Slice order and depth order differ only where two surfaces of
+    /// neighbouring slices interleave inside one pixel, at creases.)
     pub fn finish_pixel(
         &mut self,
         disparity: impl Fn(f64) -> f64,
         epsilon: f32,
         modes: &mut Vec<Mode>,
         colors: &mut Vec<[f32; 3]>,
-    ) {
+        surfaces: &mut Vec<ModeSurface>,
+    ) -> f32 {
         self.touched.sort_unstable();
         let n = self.samples.max(1) as f32;
         let mut transmittance = 1.0f32;
@@ -146,30 +189,60 @@ impl SliceAccumulator {
                 } else {
                     Vec3::ZERO
                 };
-                self.pixel_modes.push((
-                    Mode {
-                        disparity: d,
-                        depth: z as f32,
-                        eta,
-                        eta_exact,
-                    },
-                    c.to_array(),
-                ));
+                let mode = Mode {
+                    disparity: d,
+                    depth: z as f32,
+                    eta,
+                    eta_exact,
+                };
+                let surface = self.surface(k);
+                self.pixel_modes.push((mode, c.to_array(), surface));
             }
             self.alpha[k] = 0.0;
             self.alpha_z[k] = 0.0;
             self.exact[k] = 0.0;
             self.color[k] = Vec3::ZERO;
             self.color_weight[k] = 0.0;
+            self.normal[k] = Vec3::ZERO;
+            self.votes[k] = [Vote::default(); VOTES];
             self.marked[k] = false;
         }
         self.pixel_modes
             .sort_by(|a, b| a.0.depth.total_cmp(&b.0.depth));
         modes.extend(self.pixel_modes.iter().map(|m| m.0));
         colors.extend(self.pixel_modes.iter().map(|m| m.1));
+        surfaces.extend(self.pixel_modes.iter().map(|m| m.2));
         self.pixel_modes.clear();
         self.touched.clear();
         self.samples = 0;
+        std::mem::replace(&mut self.translucent_z, f32::INFINITY)
+    }
+
+    /// Slice `k`'s surface: the normalised mean normal and the ids of its heaviest object.
+    fn surface(&self, k: usize) -> ModeSurface {
+        let normal = self.normal[k].try_normalize().unwrap_or(Vec3::NAN);
+        let top = (self.votes[k].iter()).fold(Vote::default(), |a, &b| match b.weight > a.weight {
+            true => b,
+            false => a,
+        });
+        ModeSurface {
+            normal: normal.to_array(),
+            object: top.ids.object,
+            material: top.ids.material,
+            class: top.ids.class,
+        }
+    }
+}
+
+/// Adds `weight` to the vote of `ids` in a slice's tally (a new object takes a free place).
+fn vote(votes: &mut [Vote; VOTES], ids: SurfaceIds, weight: f32) {
+    if weight <= 0.0 {
+        return;
+    }
+    let place = votes.iter().position(|v| v.ids == ids || v.weight == 0.0);
+    if let Some(i) = place {
+        votes[i].ids = ids;
+        votes[i].weight += weight;
     }
 }
 
@@ -194,6 +267,9 @@ mod tests {
             z,
             coverage,
             radiance: None,
+            normal: Vec3::Z,
+            ids: SurfaceIds::default(),
+            translucent: false,
         }
     }
 
@@ -209,16 +285,89 @@ mod tests {
             ..hit(2.8, 1.0)
         };
         acc.add_sample(&[red, blue]);
-        let (mut m, mut c) = (Vec::new(), Vec::new());
-        acc.finish_pixel(|z| 1.0 / z, 1e-4, &mut m, &mut c);
+        let (mut m, mut c, mut s) = (Vec::new(), Vec::new(), Vec::new());
+        acc.finish_pixel(|z| 1.0 / z, 1e-4, &mut m, &mut c, &mut s);
         // Weights 0.5 (red) and 0.5 (blue behind it): the straight colour is their mean.
         assert_eq!(c, vec![[0.5, 0.0, 0.5]]);
     }
 
     fn finish(acc: &mut SliceAccumulator) -> Vec<Mode> {
-        let (mut m, mut c) = (Vec::new(), Vec::new());
-        acc.finish_pixel(|z| 1.0 / z, 1e-4, &mut m, &mut c);
-        m
+        finish_all(acc).0
+    }
+
+    fn finish_all(acc: &mut SliceAccumulator) -> (Vec<Mode>, Vec<ModeSurface>, f32) {
+        let (mut m, mut c, mut s) = (Vec::new(), Vec::new(), Vec::new());
+        let translucent_z = acc.finish_pixel(|z| 1.0 / z, 1e-4, &mut m, &mut c, &mut s);
+        (m, s, translucent_z)
+    }
+
+    fn ids(object: u32) -> SurfaceIds {
+        SurfaceIds {
+            object,
+            material: 10 + object,
+            class: 20 + object,
+        }
+    }
+
+    /// A crease inside one slice: three samples on face A (normal x), one on face B (normal
+    /// y), both of object 1: the mean normal is ∝ 3x + y. Then two objects in one slice:
+    /// the heavier one names the mode.
+    #[test]
+    fn a_modes_surface_is_its_mean_normal_and_heaviest_object() {
+        let mut acc = SliceAccumulator::new(8);
+        let on = |normal, object| SliceHit {
+            normal,
+            ids: ids(object),
+            ..hit(2.5, 1.0)
+        };
+        for _ in 0..3 {
+            acc.add_sample(&[on(Vec3::X, 1)]);
+        }
+        acc.add_sample(&[on(Vec3::Y, 1)]);
+        let (m, s, translucent_z) = finish_all(&mut acc);
+        assert_eq!(m.len(), 1);
+        let n = Vec3::from(s[0].normal);
+        assert!(
+            (n - Vec3::new(3.0, 1.0, 0.0).normalize()).length() < 1e-6,
+            "{n}"
+        );
+        assert_eq!((s[0].object, s[0].material, s[0].class), (1, 11, 21));
+        assert_eq!(translucent_z, f32::INFINITY);
+        // Object 2 carries 0.6 of the slice, object 1 (behind it) 0.4.
+        let front = SliceHit {
+            coverage: 0.6,
+            ..on(Vec3::Z, 2)
+        };
+        let back = SliceHit {
+            z: 2.6,
+            ..on(Vec3::Z, 1)
+        };
+        acc.add_sample(&[back, front]);
+        let (_, s, _) = finish_all(&mut acc);
+        assert_eq!(s[0].object, 1, "ray order: object 1 first, weight 1");
+        acc.add_sample(&[front, back]);
+        let (_, s, _) = finish_all(&mut acc);
+        assert_eq!(s[0].object, 2);
+    }
+
+    /// A translucent pane is reported where a sample saw it, not where it was hidden.
+    #[test]
+    fn the_nearest_visible_translucent_hit_is_reported_once() {
+        let mut acc = SliceAccumulator::new(8);
+        let pane = SliceHit {
+            translucent: true,
+            ..hit(2.5, 0.3)
+        };
+        let hidden = SliceHit {
+            translucent: true,
+            ..hit(8.5, 0.3)
+        };
+        acc.add_sample(&[hit(1.5, 1.0), hidden]);
+        assert_eq!(finish_all(&mut acc).2, f32::INFINITY);
+        acc.add_sample(&[hit(1.5, 1.0), hidden]);
+        acc.add_sample(&[pane, hit(7.5, 1.0)]);
+        assert_eq!(finish_all(&mut acc).2, 2.5);
+        assert_eq!(finish_all(&mut acc).2, f32::INFINITY);
     }
 
     #[test]
@@ -267,9 +416,7 @@ mod tests {
         let mut acc = SliceAccumulator::new(8);
         let h = |slice, z| SliceHit {
             slice,
-            z,
-            coverage: 0.5,
-            radiance: None,
+            ..hit(z, 0.5)
         };
         acc.add_sample(&[h(1, 2.0), h(5, 2.1), h(1, 2.2)]);
         let m = finish(&mut acc);

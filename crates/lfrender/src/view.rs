@@ -6,11 +6,12 @@ use super::cache::{CacheGrid, CacheParams, CacheSums, RadianceCache};
 use super::geometry::Hit;
 use super::integrator::{PathSettings, Shading};
 use super::sampler::{RayKey, Sampler};
-use super::slices::{SliceAccumulator, SliceAssignment, SliceHit};
+use super::slices::{SliceAccumulator, SliceAssignment, SliceHit, SurfaceIds};
+use super::valid::is_valid;
 use crate::camera::{CameraRay, LightFieldCamera, ViewRays};
 use crate::scene::SliceRange;
-use glam::{Vec2, Vec3};
-use lfformat::{Mode, ModeMap};
+use glam::{Mat3, Vec2, Vec3};
+use lfformat::{Mode, ModeMap, ModeSurface};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -122,9 +123,48 @@ pub struct ViewGt {
     pub modes: ModeMap,
     /// Linear colour of each mode, in [`ModeMap`] storage order.
     pub colors: Vec<[f32; 3]>,
-    /// HCI single-valued depth: the first surface with coverage ≥ 0.5 on the pixel-centre ray
-    /// (NaN where there is none).
-    pub hci_depth: Vec<f32>,
+    /// Normal and ids of each mode, in [`ModeMap`] storage order.
+    pub surfaces: Vec<ModeSurface>,
+    /// The single-valued HCI layer.
+    pub hci: HciLayer,
+    /// Where the HCI disparity is trustworthy ([`is_valid`]).
+    pub valid: Vec<bool>,
+}
+
+/// The HCI single-valued layer of an image, row-major from the top-left: per pixel, the first
+/// surface with coverage ≥ 0.5 on the pixel-centre ray.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct HciLayer {
+    pub width: usize,
+    pub height: usize,
+    /// Planar depth (NaN: no surface).
+    pub depth: Vec<f32>,
+    /// Unit geometric normal in the camera frame of [`ModeSurface::normal`] (NaN: none).
+    pub normal: Vec<[f32; 3]>,
+    /// Object, material and class ids as in [`ModeSurface`] (0: none).
+    pub object: Vec<u32>,
+    pub material: Vec<u32>,
+    pub class: Vec<u32>,
+}
+
+impl HciLayer {
+    fn push(&mut self, depth: f32, s: ModeSurface) {
+        self.depth.push(depth);
+        self.normal.push(s.normal);
+        self.object.push(s.object);
+        self.material.push(s.material);
+        self.class.push(s.class);
+    }
+
+    /// Puts the rows of `other` below these.
+    fn append(&mut self, other: HciLayer) {
+        self.depth.extend(other.depth);
+        self.normal.extend(other.normal);
+        self.object.extend(other.object);
+        self.material.extend(other.material);
+        self.class.extend(other.class);
+        self.height += other.height;
+    }
 }
 
 pub struct ViewOutput {
@@ -163,7 +203,9 @@ struct Band {
     modes: Vec<Mode>,
     mode_counts: Vec<u32>,
     colors: Vec<[f32; 3]>,
-    hci_depth: Vec<f32>,
+    surfaces: Vec<ModeSurface>,
+    hci: HciLayer,
+    valid: Vec<bool>,
     /// Pixels that got adaptive sampling's extra samples.
     refined: usize,
 }
@@ -318,6 +360,7 @@ impl RenderScene {
         let (w, h) = (cam.width(), cam.height());
         let rays = cam.view_rays(view);
         let shading = shading.seen_from(grid_position(cam, view));
+        let to_camera = camera_frame(cam);
         let bands: Vec<Band> = (0..h.div_ceil(BAND_ROWS))
             .into_par_iter()
             .map_init(
@@ -344,6 +387,7 @@ impl RenderScene {
                                 y,
                                 centre: rays.ray(x as f32 + 0.5, y as f32 + 0.5),
                                 shading,
+                                to_camera,
                             };
                             ctx.render(with_gt, scratch, &mut band);
                         }
@@ -364,11 +408,22 @@ fn grid_position(cam: &LightFieldCamera, view: u32) -> Vec2 {
     Vec2::new(u as f32, v as f32)
 }
 
+/// The rotation from world to camera frame: x right, y up, z towards the camera (every view
+/// shares the centre camera's orientation).
+fn camera_frame(cam: &LightFieldCamera) -> Mat3 {
+    let (right, up, back) = (cam.right(), cam.up, -cam.forward);
+    Mat3::from_cols(right.as_vec3(), up.as_vec3(), back.as_vec3()).transpose()
+}
+
 /// Joins bands (in row order) into the view's image and ground truth.
 fn assemble(width: usize, height: usize, bands: Vec<Band>, with_gt: bool) -> ViewOutput {
     let mut pixels = Vec::with_capacity(width * height);
     let mut modes = ModeMap::new(width, height);
-    let (mut colors, mut hci_depth, mut refined) = (Vec::new(), Vec::new(), 0);
+    let (mut colors, mut surfaces, mut valid, mut refined) = (vec![], vec![], vec![], 0);
+    let mut hci = HciLayer {
+        width,
+        ..HciLayer::default()
+    };
     for band in bands {
         refined += band.refined;
         pixels.extend(band.pixels);
@@ -378,12 +433,17 @@ fn assemble(width: usize, height: usize, bands: Vec<Band>, with_gt: bool) -> Vie
             start += n as usize;
         }
         colors.extend(band.colors);
-        hci_depth.extend(band.hci_depth);
+        surfaces.extend(band.surfaces);
+        hci.append(band.hci);
+        valid.extend(band.valid);
     }
+    hci.height = height;
     let gt = with_gt.then_some(ViewGt {
         modes,
         colors,
-        hci_depth,
+        surfaces,
+        hci,
+        valid,
     });
     ViewOutput {
         image: ViewImage {
@@ -409,6 +469,8 @@ struct PixelCtx<'a> {
     /// The ray through the pixel centre (HCI depth, slice snapping), computed once per pixel.
     centre: CameraRay,
     shading: Shading<'a>,
+    /// World to camera frame ([`camera_frame`]), for normals.
+    to_camera: Mat3,
 }
 
 impl PixelCtx<'_> {
@@ -443,18 +505,32 @@ impl PixelCtx<'_> {
         }
         band.pixels.push(sum / n as f32);
         if with_gt {
-            let before = band.modes.len();
-            let cam = self.cam;
-            scratch.acc.finish_pixel(
-                |z| cam.disparity(z),
-                s.mode_epsilon,
-                &mut band.modes,
-                &mut band.colors,
-            );
-            band.mode_counts.push((band.modes.len() - before) as u32);
-            band.hci_depth
-                .push(self.hci_depth(&scratch.centre_hits, self.centre.dir));
+            self.finish_gt(scratch, band);
         }
+    }
+
+    /// The pixel's modes, their surfaces, its HCI layer and validity, from the accumulated
+    /// hits and the pixel-centre ray.
+    fn finish_gt(&self, scratch: &mut Scratch, band: &mut Band) {
+        let before = band.modes.len();
+        let cam = self.cam;
+        let translucent_z = scratch.acc.finish_pixel(
+            |z| cam.disparity(z),
+            self.settings.mode_epsilon,
+            &mut band.modes,
+            &mut band.colors,
+            &mut band.surfaces,
+        );
+        band.mode_counts.push((band.modes.len() - before) as u32);
+        let first = self.hci_hit(&scratch.centre_hits, self.centre.dir);
+        let depth = first.map_or(f32::NAN, |h| h.t);
+        let surface = first.map_or(ModeSurface::NONE, |h| {
+            let (normal, ids) = self.surface(&h, self.centre.dir);
+            mode_surface(normal, ids)
+        });
+        band.hci.push(depth, surface);
+        let modes = &band.modes[before..];
+        band.valid.push(is_valid(modes, translucent_z, depth));
     }
 
     /// Traces `n` stratified camera samples of the pixel from the streams of `stream`
@@ -561,11 +637,15 @@ impl PixelCtx<'_> {
                 false => None,
             };
             let slice = self.slice_of(h, centre.origin, centre.dir, centre_hits);
+            let (normal, ids) = self.surface(h, dir);
             scratch.slice_hits.push(SliceHit {
                 slice,
                 z: h.t,
                 coverage: geo.coverage(mats, h, dir),
                 radiance: shaded,
+                normal,
+                ids,
+                translucent: self.translucent(h),
             });
         }
         scratch.acc.add_sample(&scratch.slice_hits);
@@ -656,13 +736,58 @@ impl PixelCtx<'_> {
         self.slices.index(z) as u32
     }
 
-    /// HCI semantics: depth of the first surface with coverage ≥ 0.5 on the pixel-centre ray.
-    fn hci_depth(&self, centre_hits: &[Hit], dir: Vec3) -> f32 {
+    /// HCI semantics: the first surface with coverage ≥ 0.5 on the pixel-centre ray.
+    fn hci_hit(&self, centre_hits: &[Hit], dir: Vec3) -> Option<Hit> {
+        self.scene.hci_hit(centre_hits, dir)
+    }
+
+    /// A hit's geometric normal in the camera frame, turned to face the camera, and its ids.
+    fn surface(&self, h: &Hit, dir: Vec3) -> (Vec3, SurfaceIds) {
+        self.scene.hit_surface(h, dir, &self.to_camera)
+    }
+
+    /// Whether what lies behind the hit shows through it: glass, or a coverage strictly
+    /// between 0 and 1.
+    fn translucent(&self, h: &Hit) -> bool {
         let (geo, mats) = (&self.scene.geometry, &self.scene.materials);
-        let first = centre_hits
-            .iter()
-            .find(|h| geo.coverage(mats, h, dir) >= 0.5);
-        first.map_or(f32::NAN, |h| h.t)
+        let a = geo.hit_opacity(mats, h);
+        let material = &mats[geo.shading[h.tri as usize].material as usize];
+        material.glass_ior.is_some() || (a > 0.0 && a < 1.0)
+    }
+}
+
+/// A mode surface of a single hit.
+fn mode_surface(normal: Vec3, ids: SurfaceIds) -> ModeSurface {
+    ModeSurface {
+        normal: normal.to_array(),
+        object: ids.object,
+        material: ids.material,
+        class: ids.class,
+    }
+}
+
+impl RenderScene {
+    /// HCI semantics: the first of `hits` (sorted front to back, along `dir`) with coverage
+    /// ≥ 0.5.
+    fn hci_hit(&self, hits: &[Hit], dir: Vec3) -> Option<Hit> {
+        let (geo, mats) = (&self.geometry, &self.materials);
+        hits.iter()
+            .find(|h| geo.coverage(mats, h, dir) >= 0.5)
+            .copied()
+    }
+
+    /// A hit's geometric normal turned to face the ray's origin, rotated by `to_camera`, and
+    /// the ids of its object, material and class.
+    fn hit_surface(&self, h: &Hit, dir: Vec3, to_camera: &Mat3) -> (Vec3, SurfaceIds) {
+        let n = self.geometry.geometric_normal(h.tri);
+        let n = if n.dot(dir) > 0.0 { -n } else { n };
+        let s = &self.geometry.shading[h.tri as usize];
+        let ids = SurfaceIds {
+            object: s.object + 1,
+            material: s.material + 1,
+            class: self.classes[s.object as usize],
+        };
+        (*to_camera * n, ids)
     }
 }
 

@@ -10,6 +10,7 @@
 pub mod assets;
 pub mod files;
 pub mod gltf;
+pub mod labels;
 pub mod light;
 pub mod material;
 pub mod memory;
