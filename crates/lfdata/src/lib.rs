@@ -20,6 +20,7 @@ pub mod npz;
 pub mod posterior;
 pub mod prediction;
 pub mod progress;
+pub mod regions;
 pub mod scene_eval;
 pub mod stack_cost;
 pub mod stacks;

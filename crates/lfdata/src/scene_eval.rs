@@ -9,6 +9,7 @@ use crate::bins::Bins;
 use crate::metrics::Frame;
 use crate::metrics::hci::{self, HciScores};
 use crate::metrics::kld::{self, KldSums};
+use crate::metrics::region::{RegionScores, RegionTruth};
 use crate::metrics::sparsification::Sparsification;
 use crate::prediction::ScenePrediction;
 use crate::truth::{self, EtaKind, Reference, SceneTruth};
@@ -82,6 +83,8 @@ pub struct SceneScores {
     pub uncertainty: Option<UncertaintySource>,
     /// `discrete`, `laplace`, `mixture` or `point` (only a disparity map).
     pub distribution: &'static str,
+    /// The HCI region metrics against `gt_disp_lowres.pfm`, where the scene has masks.
+    pub regions: Option<RegionScores>,
 }
 
 impl SceneScores {
@@ -103,6 +106,8 @@ pub struct PreparedTruth<'a> {
     pub frame: Frame,
     /// Unimodal ground truth per reference, in [`Reference::ALL`] order.
     pub references: Vec<(Reference, Vec<f32>)>,
+    /// The scene's evaluation masks, when it has them.
+    pub regions: Option<RegionTruth>,
 }
 
 impl<'a> PreparedTruth<'a> {
@@ -120,7 +125,13 @@ impl<'a> PreparedTruth<'a> {
                 border: cfg.border,
             },
             references,
+            regions: None,
         }
+    }
+
+    /// With the scene's evaluation masks, so [`evaluate`] scores the HCI region metrics.
+    pub fn with_regions(self, regions: Option<RegionTruth>) -> Self {
+        Self { regions, ..self }
     }
 
     /// The unimodal ground truth by `reference`.
@@ -160,6 +171,10 @@ pub fn evaluate(gt: &PreparedTruth, pred: &ScenePrediction, cfg: &EvalConfig) ->
         invalid_percent: hci::invalid_percent(disparity, &gt.frame),
         uncertainty: uncertainty.map(|(source, _)| source),
         distribution: pred.posterior.as_ref().map_or("point", |p| p.form_name()),
+        regions: gt
+            .regions
+            .as_ref()
+            .map(|r| RegionScores::compute(disparity, gt.reference(Reference::Hci), &gt.frame, r)),
     }
 }
 

@@ -11,6 +11,7 @@ use indicatif::{ParallelProgressIterator, ProgressIterator};
 use lfdata::bins::Bins;
 use lfdata::prediction::{Method, write_prediction};
 use lfdata::progress::progress;
+use lfdata::regions::load_region_truth;
 use lfdata::scene_eval::{EvalConfig, MAIN_BADPIX, PreparedTruth, SceneScores, evaluate};
 use lfdata::truth::{EtaKind, HCI_GT_FILE, Reference, SceneTruth};
 use lfformat::dataset::SceneDir;
@@ -146,8 +147,9 @@ fn evaluate_scene(
 ) -> Result<SceneOutcome> {
     let cfg = &opts.config;
     let truth = SceneTruth::load(&scene.path)?;
-    let gt = PreparedTruth::new(&truth, cfg);
     let (w, h) = (truth.width(), truth.height());
+    let regions = load_region_truth(&scene.path, w, h)?;
+    let gt = PreparedTruth::new(&truth, cfg).with_regions(regions);
     let mut samples = plot_pixels(scene, index, &truth, &gt, opts)?;
     // The view only shades the error maps; a scene without views is still evaluated.
     let shade = centre_view(&scene.path)

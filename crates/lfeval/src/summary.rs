@@ -10,6 +10,7 @@ use std::collections::BTreeMap;
 use lfdata::metrics::hci::HciScores;
 use lfdata::metrics::kld::{KldScores, KldSums};
 use lfdata::metrics::mean;
+use lfdata::metrics::region::RegionScores;
 use lfdata::metrics::sparsification::{Sparsification, fractions};
 use lfdata::scene_eval::SceneScores;
 use lfdata::truth::Reference;
@@ -65,6 +66,8 @@ pub struct MethodSummary {
     pub runtime_mean_s: Option<f64>,
     /// Mean percentage of non-finite predictions.
     pub invalid_percent: Option<f64>,
+    /// Mean HCI region scores over the scenes with evaluation masks.
+    pub regions: Option<RegionScores>,
 }
 
 impl MethodSummary {
@@ -85,8 +88,15 @@ impl MethodSummary {
             sparsification: sparsification(scenes, steps),
             runtime_mean_s: mean(scenes.iter().map(|s| s.runtime_s)),
             invalid_percent: mean(scenes.iter().map(|s| s.invalid_percent)),
+            regions: regions(scenes),
         }
     }
+}
+
+/// Region scores averaged over the scenes that have them, `None` when no scene has masks.
+fn regions(scenes: &[SceneScores]) -> Option<RegionScores> {
+    let with: Vec<RegionScores> = scenes.iter().filter_map(|s| s.regions).collect();
+    (!with.is_empty()).then(|| RegionScores::mean(&with))
 }
 
 /// Dataset sparsification, only when every scene has one: a partial average would compare
@@ -136,6 +146,7 @@ mod tests {
             sparsification: sp,
             runtime_s: runtime,
             invalid_percent: Some(0.0),
+            regions: None,
             uncertainty: None,
             distribution: "point",
         }

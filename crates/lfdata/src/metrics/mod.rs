@@ -1,11 +1,13 @@
 //! Pure metric functions: no I/O, plain slices in, numbers out, each unit-tested with
 //! hand-computed values.
 //!
-//! [`hci`] holds the HCI toolkit's unimodal scores, [`kld`] the thesis' discrete KLD
-//! (eq. 5.21–5.23), [`sparsification`] the uncertainty ranking curves and AuSE.
+//! [`hci`] holds the HCI toolkit's unimodal scores, [`region`] its region metrics on the
+//! scenes' evaluation masks, [`kld`] the thesis' discrete KLD (eq. 5.21–5.23),
+//! [`sparsification`] the uncertainty ranking curves and AuSE.
 
 pub mod hci;
 pub mod kld;
+pub mod region;
 pub mod sparsification;
 
 /// The evaluated region: the image without a `border`-pixel frame (HCI: 15 px), because the

@@ -6,6 +6,7 @@ use std::path::Path;
 use anyhow::Result;
 use lfdata::metrics::hci::HciScores;
 use lfdata::metrics::kld::KldScores;
+use lfdata::metrics::region::RegionScores;
 use lfdata::scene_eval::{EvalConfig, SceneScores, UncertaintySource};
 use serde::Serialize;
 
@@ -46,6 +47,7 @@ struct SceneJson {
     invalid_percent: Option<f64>,
     uncertainty: Option<UncertaintySource>,
     distribution: &'static str,
+    regions: Option<RegionScores>,
 }
 
 impl SceneJson {
@@ -60,6 +62,7 @@ impl SceneJson {
             invalid_percent: s.invalid_percent,
             uncertainty: s.uncertainty,
             distribution: s.distribution,
+            regions: s.regions,
         }
     }
 }

@@ -10,6 +10,7 @@ use std::path::Path;
 
 use anyhow::Result;
 use lfdata::metrics::hci::SCORE_NAMES;
+use lfdata::metrics::region::{REGION_SCORE_NAMES, Resolution};
 use lfdata::truth::Reference;
 
 use super::{
@@ -215,6 +216,41 @@ pub fn hci_table(eval: &Evaluation, reference: Reference) -> Table {
     }
 }
 
+/// The HCI region scores of every method, when some scene has evaluation masks.
+pub fn region_table(eval: &Evaluation) -> Option<Table> {
+    let summaries: Vec<_> = eval.methods.iter().map(|m| m.summary.regions).collect();
+    let resolution = summaries.iter().flatten().find_map(|r| r.fine_resolution);
+    summaries.iter().any(Option::is_some).then(|| {
+        let mut header = vec!["Method".to_string()];
+        header.extend(REGION_SCORE_NAMES.iter().map(|s| s.to_string()));
+        let rows = eval
+            .methods
+            .iter()
+            .zip(&summaries)
+            .map(|(m, r)| {
+                (
+                    m.method.name.clone(),
+                    r.map_or(vec![None; 7], |r| r.to_array().to_vec()),
+                )
+            })
+            .collect();
+        let fine = match resolution {
+            Some(Resolution::High) => "on the high-resolution ground truth",
+            _ => "on the low-resolution masks (no high-resolution ground truth)",
+        };
+        Table {
+            title: "HCI region scores against gt_disp_lowres.pfm".into(),
+            header,
+            rows,
+            note: format!(
+                "Mean over the scenes with evaluation masks, computed as the HCI toolkit does; \
+                 Discont., Fine Fat. and Fine Thin. {fine}."
+            ),
+            best_per_row: false,
+        }
+    })
+}
+
 /// BadPix(0.07) of every method per scene, against the configured reference.
 pub fn scene_table(eval: &Evaluation) -> Table {
     let r = eval.config.reference;
@@ -246,6 +282,7 @@ pub fn scene_table(eval: &Evaluation) -> Table {
 pub fn tables(eval: &Evaluation) -> Vec<Table> {
     let mut t = vec![main_table(eval)];
     t.extend(Reference::ALL.iter().map(|&r| hci_table(eval, r)));
+    t.extend(region_table(eval));
     t.push(scene_table(eval));
     t
 }
