@@ -1,28 +1,28 @@
-//! A light field in memory (the views the four stacks need), with the geometric operations of
-//! the data pipeline: cropping and rotation by 90°.
+//! A light field in memory (the views a cost volume or a network reads), with the geometric
+//! operations of the data pipeline: cropping, rotation by 90° and down-scaling.
 //!
 //! Views are addressed by grid column `u` and row `v` (row 0 on top, as HCI's file index
-//! `v * n + u`); pixels are RGB in `[0, 1]`, row-major, top row first. Only the star (centre row,
-//! column and both diagonals) is loaded: the other views are never used by an EPINET network,
-//! and leaving them out cuts memory by 2.5× on a 9×9 grid.
+//! `v * nx + u`); pixels are RGB in `[0, 1]`, row-major, top row first. Only the views a
+//! consumer asks for are loaded (a [`ViewSet`]): training reads the star (centre row, column and
+//! both diagonals), which cuts memory by 2.5× on a 9×9 grid; the classical baseline the cross.
 
 use std::path::Path;
 
 use anyhow::{Result, bail};
-use lfformat::HciParameters;
-use lfformat::dataset::PARAMETERS_FILE;
-use lfformat::views::{ViewSet, read_rgb};
+use lfformat::views::{ViewSet, read_grid, read_view};
 
-/// The star views of a square `n × n` camera grid.
+/// Some views of an `nx × ny` camera grid (both odd).
 #[derive(Clone, Debug, PartialEq)]
 pub struct LightField {
-    /// Views per grid side (odd).
-    pub n: usize,
+    /// Views per grid row (columns `u`).
+    pub nx: usize,
+    /// Views per grid column (rows `v`).
+    pub ny: usize,
     /// Image columns.
     pub width: usize,
     /// Image rows.
     pub height: usize,
-    /// `n * n` entries, index `v * n + u`; `None` off the star.
+    /// `nx * ny` entries, index `v * nx + u`; `None` for a view that was not loaded.
     pub views: Vec<Option<Vec<f32>>>,
     /// The scene's disparity range `[disp_min, disp_max]` from `parameters.cfg` (EPI-Shift's
     /// inference shifts cover it); `None` for light fields built in memory.
@@ -30,38 +30,50 @@ pub struct LightField {
 }
 
 impl LightField {
-    /// Reads `parameters.cfg` and the star views of the scene folder `dir`.
-    pub fn load(dir: &Path) -> Result<Self> {
-        let params = HciParameters::read(&dir.join(PARAMETERS_FILE))?;
+    /// Reads `parameters.cfg` and the views of `set` from the scene folder `dir`.
+    pub fn load(dir: &Path, set: ViewSet) -> Result<Self> {
+        Self::load_views(dir, |nx, ny| Ok(set.positions(nx, ny)))
+    }
+
+    /// Reads the star views of the scene folder `dir`, whose grid must be square: what the
+    /// four stacks of a network need.
+    pub fn load_star(dir: &Path) -> Result<Self> {
+        Self::load_views(dir, |nx, ny| {
+            if nx != ny {
+                bail!(
+                    "{}: a {nx}x{ny} camera grid; the four stacks need a square grid with an odd side",
+                    dir.display()
+                );
+            }
+            Ok(ViewSet::Star.positions(nx, ny))
+        })
+    }
+
+    /// Reads the views at the grid positions `select(nx, ny)` returns.
+    fn load_views(
+        dir: &Path,
+        select: impl FnOnce(usize, usize) -> Result<Vec<(usize, usize)>>,
+    ) -> Result<Self> {
+        let params = read_grid(dir)?;
         let (nx, ny) = (params.num_cams_x as usize, params.num_cams_y as usize);
-        if nx != ny || nx.is_multiple_of(2) {
-            bail!(
-                "{}: a {nx}x{ny} camera grid; the four stacks need a square grid with an odd side",
-                dir.display()
-            );
-        }
-        let (width, height) = (
-            params.image_resolution_x_px as usize,
-            params.image_resolution_y_px as usize,
-        );
-        let mut views = vec![None; nx * nx];
-        for (u, v) in ViewSet::Star.positions(nx, nx) {
-            let path = dir.join(format!("input_Cam{:03}.png", v * nx + u));
-            views[v * nx + u] = Some(read_rgb(&path, width, height)?);
+        let mut views = vec![None; nx * ny];
+        for (u, v) in select(nx, ny)? {
+            views[v * nx + u] = Some(read_view(dir, &params, (u, v))?);
         }
         let range = [params.disp_min as f32, params.disp_max as f32];
         Ok(Self {
-            n: nx,
-            width,
-            height,
+            nx,
+            ny,
+            width: params.image_resolution_x_px as usize,
+            height: params.image_resolution_y_px as usize,
             views,
             disparity_range: (range.iter().all(|d| d.is_finite()) && range[0] <= range[1])
                 .then_some(range),
         })
     }
 
-    /// Builds a light field from a function of grid position and pixel, for every star view
-    /// (synthetic scenes in tests and examples).
+    /// Builds the star views of a square `n × n` grid from a function of grid position and
+    /// pixel (synthetic scenes in tests and examples).
     pub fn from_fn(
         n: usize,
         width: usize,
@@ -79,7 +91,8 @@ impl LightField {
             views[v * n + u] = Some(rgb);
         }
         Self {
-            n,
+            nx: n,
+            ny: n,
             width,
             height,
             views,
@@ -87,19 +100,26 @@ impl LightField {
         }
     }
 
-    /// Index of the centre view (`Cam040` of 9×9).
-    pub fn centre(&self) -> usize {
-        self.n / 2
+    /// Grid position `(u, v)` of the centre view (`Cam040` of 9×9).
+    pub fn centre(&self) -> (usize, usize) {
+        (self.nx / 2, self.ny / 2)
     }
 
     /// The view at column `u`, row `v`.
     ///
     /// # Panics
-    /// If the view is not on the star (a stack geometry bug, not a data error).
+    /// If the view was not loaded (a view-selection bug, not a data error).
     pub fn view(&self, u: usize, v: usize) -> &[f32] {
-        self.views[v * self.n + u]
+        self.views[v * self.nx + u]
             .as_deref()
-            .unwrap_or_else(|| panic!("view ({u}, {v}) is not on the star"))
+            .unwrap_or_else(|| panic!("view ({u}, {v}) was not loaded"))
+    }
+
+    /// The loaded views with their grid positions `(u, v)`, in file order.
+    pub fn loaded(&self) -> impl Iterator<Item = ((usize, usize), &[f32])> {
+        let nx = self.nx;
+        (self.views.iter().enumerate())
+            .filter_map(move |(i, view)| Some(((i % nx, i / nx), view.as_deref()?)))
     }
 
     /// The `w × h` region at `(x0, y0)` (which may reach outside the image: edge pixels are
@@ -117,7 +137,8 @@ impl LightField {
             .collect();
         let k = step.max(1) as f32;
         Self {
-            n: self.n,
+            nx: self.nx,
+            ny: self.ny,
             width: w,
             height: h,
             views,
@@ -132,18 +153,19 @@ impl LightField {
     /// `R w` with the same linear map `R`; since a point of disparity `d` appears at `p - d w`
     /// in view `w`, it appears at `R p - d R w` after the rotation: same disparity.
     pub fn rotate90(&self) -> Self {
-        let n = self.n;
-        let views = (0..n * n)
+        let (nx, ny) = (self.nx, self.ny);
+        let views = (0..nx * ny)
             .map(|i| {
-                let (u, v) = (i % n, i / n);
-                let (ou, ov) = rotate_source(u, v, n, n);
-                self.views[ov * n + ou]
+                let (u, v) = (i % ny, i / ny);
+                let (ou, ov) = rotate_source(u, v, nx, ny);
+                self.views[ov * nx + ou]
                     .as_ref()
                     .map(|rgb| rotate_plane(rgb, self.width, self.height, 3))
             })
             .collect();
         Self {
-            n,
+            nx: ny,
+            ny: nx,
             width: self.height,
             height: self.width,
             views,
@@ -171,7 +193,8 @@ impl LightField {
             })
             .collect();
         Self {
-            n: self.n,
+            nx: self.nx,
+            ny: self.ny,
             width: w,
             height: h,
             views,

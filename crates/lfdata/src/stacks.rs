@@ -74,8 +74,9 @@ impl Region {
     }
 }
 
-/// The stack `dir` of `lf` over `region`, EPI-shifted by `shift` pixels, channel-major:
-/// `n * 3` planes (view after view, R G B) of `region.width × region.height`.
+/// The stack `dir` of `lf` (a square `n × n` grid, as [`LightField::load_star`] reads) over
+/// `region`, EPI-shifted by `shift` pixels, channel-major: `n * 3` planes (view after view,
+/// R G B) of `region.width × region.height`.
 ///
 /// The shift is `L^s(x, y, u, v) = L^0(x - du s, y - dv s, u, v)` with `(du, dv)` the view's
 /// offset from the centre (thesis eq. 4.2, 5.11; the diagonal stacks get both shifts), read
@@ -83,21 +84,40 @@ impl Region {
 /// disparity `d` has disparity `d - s` in the shifted light field: it lies at `x - du d` in
 /// view `du`, and `x' - du s = x - du d` gives `x' = x - du (d - s)`.
 pub fn extract(lf: &LightField, dir: Direction, region: Region, shift: f32) -> Vec<f32> {
-    let mut out = vec![0.0; lf.n * 3 * region.width * region.height];
+    let mut out = vec![0.0; lf.nx * 3 * region.width * region.height];
     extract_into(lf, dir, region, shift, &mut out);
     out
 }
 
 /// [`extract`] into `out` (`n * 3` planes of the region), for callers that refill one buffer.
 pub fn extract_into(lf: &LightField, dir: Direction, region: Region, shift: f32, out: &mut [f32]) {
-    let c = lf.centre() as f32;
     let plane = region.width * region.height;
-    for (k, (u, v)) in dir.positions(lf.n).into_iter().enumerate() {
-        let view = lf.view(u, v);
-        let (ox, oy) = (-(u as f32 - c) * shift, -(v as f32 - c) * shift);
-        let planes = &mut out[k * 3 * plane..(k + 1) * 3 * plane];
-        sample_shifted(view, lf.width, lf.height, region, (ox, oy), planes);
+    for (k, at) in dir.positions(lf.nx).into_iter().enumerate() {
+        shift_view(
+            lf,
+            at,
+            region,
+            shift,
+            &mut out[k * 3 * plane..(k + 1) * 3 * plane],
+        );
     }
+}
+
+/// View `(u, v)` of `lf` over `region`, EPI-shifted by `shift` pixels (see [`extract`]), as
+/// three planes (R, G, B) of `region.width × region.height` into `out`.
+pub fn shift_view(
+    lf: &LightField,
+    (u, v): (usize, usize),
+    region: Region,
+    shift: f32,
+    out: &mut [f32],
+) {
+    let (cu, cv) = lf.centre();
+    let offset = (
+        -((u as f32 - cu as f32) * shift),
+        -((v as f32 - cv as f32) * shift),
+    );
+    sample_shifted(lf.view(u, v), lf.width, lf.height, region, offset, out);
 }
 
 /// Bilinear samples of the RGB image `rgb` at `(x + ox, y + oy)` for every pixel of `region`
@@ -189,6 +209,23 @@ mod tests {
             vec![0, 10, 20, 30, 40, 50, 60, 70, 80]
         );
         assert_eq!(Direction::Vertical.view_indices(3), vec![7, 4, 1]);
+    }
+
+    #[test]
+    fn a_shift_moves_by_whole_and_fractional_pixels_with_clamping() {
+        // 4×1 grey ramp 0, 1, 2, 3 in all channels.
+        let rgb: Vec<f32> = (0..4).flat_map(|v| [v as f32; 3]).collect();
+        let region = Region {
+            x0: 0,
+            y0: 0,
+            width: 4,
+            height: 1,
+        };
+        let mut out = vec![0.0; 12];
+        sample_shifted(&rgb, 4, 1, region, (1.0, 0.0), &mut out);
+        assert_eq!(out[..4], [1.0, 2.0, 3.0, 3.0]);
+        sample_shifted(&rgb, 4, 1, region, (-0.25, 0.0), &mut out);
+        assert_eq!(out[..4], [0.0, 0.75, 1.75, 2.75]);
     }
 
     /// The interior fast path of `sample_shifted` gives bit for bit what clamping every

@@ -1,5 +1,5 @@
-//! The views of a scene folder (`input_CamNNN.png`) as RGB in `[0, 1]`: the reader that
-//! evaluation baselines and training share.
+//! The views of a scene folder (`input_CamNNN.png`): the subsets of the view grid that
+//! evaluation baselines and training read, and the reader of one view as RGB in `[0, 1]`.
 
 use std::io::BufReader;
 use std::path::Path;
@@ -50,74 +50,41 @@ impl ViewSet {
     }
 }
 
-/// One view: its offset from the centre in grid steps and its RGB pixels in `[0, 1]`.
-pub struct View {
-    /// Columns right of the centre view.
-    pub du: f32,
-    /// Rows below the centre view.
-    pub dv: f32,
-    /// `width * height * 3` values, row-major, top row first.
-    pub rgb: Vec<f32>,
+/// `parameters.cfg` of the scene folder `dir`, checked to describe a view grid with a centre
+/// view (odd counts, as HCI's).
+pub fn read_grid(dir: &Path) -> Result<HciParameters> {
+    let params = HciParameters::read(&dir.join(PARAMETERS_FILE))?;
+    let (nx, ny) = (params.num_cams_x, params.num_cams_y);
+    if nx % 2 == 0 || ny % 2 == 0 {
+        return Err(Error::format(
+            dir,
+            format!("the camera grid {nx}x{ny} has no centre view"),
+        ));
+    }
+    Ok(params)
 }
 
-/// The views of a scene that a cost volume needs.
-pub struct LightField {
-    /// Columns.
-    pub width: usize,
-    /// Rows.
-    pub height: usize,
-    /// The selected views, the centre one included.
-    pub views: Vec<View>,
-}
-
-impl LightField {
-    /// Reads `parameters.cfg` and the views of `set` from the scene folder `dir`.
-    pub fn load(dir: &Path, set: ViewSet) -> Result<Self> {
-        Self::load_positions(dir, |nx, ny| set.positions(nx, ny))
-    }
-
-    /// Reads the views at the grid positions `positions(nx, ny)` returns.
-    fn load_positions(
-        dir: &Path,
-        positions: impl FnOnce(usize, usize) -> Vec<(usize, usize)>,
-    ) -> Result<Self> {
-        let params = HciParameters::read(&dir.join(PARAMETERS_FILE))?;
-        let (nx, ny) = (params.num_cams_x as usize, params.num_cams_y as usize);
-        if nx % 2 == 0 || ny % 2 == 0 {
-            return Err(Error::format(
-                dir,
-                format!("the camera grid {nx}x{ny} has no centre view"),
-            ));
-        }
-        let (width, height) = (
-            params.image_resolution_x_px as usize,
-            params.image_resolution_y_px as usize,
-        );
-        let views = positions(nx, ny)
-            .into_iter()
-            .map(|(u, v)| {
-                let path = dir.join(format!("input_Cam{:03}.png", v * nx + u));
-                let rgb = read_rgb(&path, width, height)?;
-                Ok(View {
-                    du: u as f32 - (nx / 2) as f32,
-                    dv: v as f32 - (ny / 2) as f32,
-                    rgb,
-                })
-            })
-            .collect::<Result<_>>()?;
-        Ok(Self {
-            width,
-            height,
-            views,
-        })
-    }
+/// The view at grid column `u`, row `v` of the scene folder `dir` (with its `parameters.cfg`
+/// as [`read_grid`] returns it) as RGB in `[0, 1]`.
+pub fn read_view(dir: &Path, params: &HciParameters, (u, v): (usize, usize)) -> Result<Vec<f32>> {
+    let index = v * params.num_cams_x as usize + u;
+    read_rgb(
+        &dir.join(format!("input_Cam{index:03}.png")),
+        params.image_resolution_x_px as usize,
+        params.image_resolution_y_px as usize,
+    )
 }
 
 /// The centre view of the scene in `dir` as RGB in `[0, 1]`, with its width and height.
 pub fn centre_view(dir: &Path) -> Result<(Vec<f32>, usize, usize)> {
-    let lf = LightField::load_positions(dir, |nx, ny| vec![(nx / 2, ny / 2)])?;
-    let view = lf.views.into_iter().next().expect("one view requested");
-    Ok((view.rgb, lf.width, lf.height))
+    let params = read_grid(dir)?;
+    let centre = (
+        params.num_cams_x as usize / 2,
+        params.num_cams_y as usize / 2,
+    );
+    let rgb = read_view(dir, &params, centre)?;
+    let size = (params.image_resolution_x_px, params.image_resolution_y_px);
+    Ok((rgb, size.0 as usize, size.1 as usize))
 }
 
 /// An 8-bit (or 16-bit) image as RGB in `[0, 1]`, checked against the expected size.

@@ -116,7 +116,7 @@ pub enum NetInput {
     /// The stack's views, `n × 3` planes (thesis appendix B.1).
     Views,
     /// The stack's plane-sweep cost volume: for every `[dpp]` bin centre `h`, the colour
-    /// variance of the stack's views EPI-shifted by `h` ([`lfdata::stack_cost`]). The network then
+    /// variance of the stack's views EPI-shifted by `h` ([`lfdata::cost::cost_stack`]). The network then
     /// scores the hypotheses (one logit each, and UPR's and ESE's `log b`) and BASE, UPR and
     /// ESE take their disparity as the softmax-weighted mean of the bin centres (a soft
     /// argmin, as GC-Net's), DPP the logits as its posterior. Not in the thesis: a CPU-budget

@@ -2,7 +2,7 @@
 //! views, or its plane-sweep cost volume over the `[dpp]` bin centres.
 
 use lfdata::lightfield::LightField;
-use lfdata::stack_cost::cost_stack;
+use lfdata::cost::cost_stack;
 use lfdata::stacks::{Direction, Region, extract};
 
 use crate::config::{NetInput, TrainConfig};

@@ -59,7 +59,7 @@ fn run_once(
     device: &Device,
 ) -> Vec<Vec<f32>> {
     let region = Region::whole(lf);
-    let shape = [1, input.channels(lf.n), lf.height, lf.width];
+    let shape = [1, input.channels(lf.nx), lf.height, lf.width];
     let planes = |dir| input.planes(lf, dir, region, shift);
     let stacks = Direction::ALL.map(|dir| tensor4(planes(dir), shape, device));
     let out = values(decode(net.forward(stacks), model, input));
@@ -411,14 +411,14 @@ pub fn predict_dataset_over(
     let bar = lfdata::progress::progress(scenes.len(), "predicting", quiet);
     let mut ranges = Vec::new();
     for s in &scenes {
-        let lf = LightField::load(&s.path)?;
+        let lf = LightField::load_star(&s.path)?;
         ranges.extend(lf.disparity_range.map(|r| (s.name.clone(), r)));
-        if lf.n != state.grid {
+        if lf.nx != state.grid {
             anyhow::bail!(
                 "{}: {}x{} views, the network was trained on {}x{}",
                 s.path.display(),
-                lf.n,
-                lf.n,
+                lf.nx,
+                lf.nx,
                 state.grid,
                 state.grid
             );

@@ -99,7 +99,7 @@ pub fn make_sample(
     border: usize,
     input: &StackInput,
 ) -> Sample {
-    let c = scene.lf.centre() as f32;
+    let c = scene.lf.centre().0 as f32;
     let margin = (c * (draw.shift.abs() + input.reach())).ceil() as usize + 1;
     let (x0, y0) = (draw.origin.0 as isize, draw.origin.1 as isize);
     let (m, k) = (margin as isize, draw.scale.max(1));
@@ -113,9 +113,9 @@ pub fn make_sample(
         width: patch,
         height: patch,
     };
-    let c = lf.centre();
+    let (cu, cv) = lf.centre();
     let centre = crop_plane(
-        lf.view(c, c),
+        lf.view(cu, cv),
         lf.width,
         lf.height,
         3,

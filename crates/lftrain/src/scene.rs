@@ -104,7 +104,7 @@ pub struct Scene {
 impl Scene {
     /// Loads views and ground truth (`modes.exr` if present, else `gt_disp_lowres.pfm`).
     pub fn load(dir: &Path, name: &str, modes: usize, unimodal: Unimodal) -> Result<Self> {
-        let lf = LightField::load(dir)?;
+        let lf = LightField::load_star(dir)?;
         let truth = SceneTruth::load(dir)?;
         if (truth.width(), truth.height()) != (lf.width, lf.height) {
             bail!(
@@ -127,9 +127,9 @@ impl Scene {
 
     /// The scene with its flat pixels masked ([`texture_mask`] of the centre view).
     pub fn with_texture_mask(self, window: usize, threshold: f32) -> Self {
-        let c = self.lf.centre();
+        let (cu, cv) = self.lf.centre();
         let (w, h) = (self.lf.width, self.lf.height);
-        let texture = texture_mask(self.lf.view(c, c), w, h, window, threshold);
+        let texture = texture_mask(self.lf.view(cu, cv), w, h, window, threshold);
         Self { texture, ..self }
     }
 }

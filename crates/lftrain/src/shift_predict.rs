@@ -121,7 +121,7 @@ pub fn run_shifts(
         width: pw,
         height: ph,
     };
-    let shape = [1, lf.n * 3, ph, pw];
+    let shape = [1, lf.nx * 3, ph, pw];
     let stacks = |t: i32, dir| tensor4(extract(lf, dir, region, t as f32), shape, device);
     let features = |t: i32| {
         [
@@ -129,7 +129,7 @@ pub fn run_shifts(
             net.features(stacks(t, Direction::Vertical), true),
         ]
     };
-    let c = lf.centre();
+    let (c, _) = lf.centre();
     let centre = stacks(0, Direction::Horizontal).narrow(1, 3 * c, 3);
     let mut window: VecDeque<[Tensor<4>; 2]> = VecDeque::new();
     let mut maps = ShiftMaps {

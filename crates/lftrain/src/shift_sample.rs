@@ -43,7 +43,7 @@ pub fn make_shift_sample(
 ) -> ShiftSample {
     let base = draw.shift.round() as i32;
     let half = offsets.iter().map(|k| k.abs()).max().unwrap_or(0);
-    let c = scene.lf.centre();
+    let (c, _) = scene.lf.centre();
     let reach = c * (base.unsigned_abs() as usize + half as usize + 1);
     let margin = reach + 1;
     let (x0, y0) = (draw.origin.0 as isize, draw.origin.1 as isize);

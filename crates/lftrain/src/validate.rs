@@ -32,7 +32,7 @@ pub fn load_scenes(dirs: &[SceneDir]) -> Result<Vec<ValScene>> {
         .map(|d| {
             Ok(ValScene {
                 name: d.name.clone(),
-                lf: LightField::load(&d.path)?,
+                lf: LightField::load_star(&d.path)?,
                 truth: SceneTruth::load(&d.path)?,
             })
         })

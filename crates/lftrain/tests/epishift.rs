@@ -142,7 +142,7 @@ fn inference_shifts_cover_the_range_of_parameters_cfg() {
         ..TwoPlanes::new(3, 16)
     };
     scene.write(dir.path(), false).unwrap();
-    let lf = lfdata::lightfield::LightField::load(dir.path()).unwrap();
+    let lf = lfdata::lightfield::LightField::load_star(dir.path()).unwrap();
     // HCI writes the range widened: [-6.1, 5.1].
     let r = lf.disparity_range.unwrap();
     assert!(

@@ -7,10 +7,11 @@ use std::time::Instant;
 
 use lfdata::bins::Bins;
 use lfdata::cost::{box_filter, cost_volume};
+use lfdata::lightfield::LightField;
 use lfdata::posterior::{PosteriorForm, PosteriorMap};
 use lfdata::prediction::{ScenePrediction, point_estimates};
 use lfformat::pfm::FloatImage;
-use lfformat::views::{LightField, ViewSet};
+use lfformat::views::ViewSet;
 use rayon::prelude::*;
 use serde::Serialize;
 
