@@ -2,13 +2,13 @@
 //! dataset, writes a prediction or compares the two, once.
 //!
 //! Layout: [`lightfield`] the views in memory (loading, crop, rotation), [`stacks`] the view
-//! stacks through the centre view and the bilinear EPI shift, [`cost`] and [`stack_cost`] the
-//! plane-sweep cost volumes; [`bins`] and [`laplace`] the discretisation maths, [`posterior`]
-//! the predicted distributions, [`prediction`] (with [`npz`]) the prediction files, [`truth`]
-//! the ground truth (modes, front-most mode, masks); [`metrics`] the pure metric functions and
-//! [`scene_eval`] every metric of one method on one scene; [`progress`] and [`font`] the
-//! terminal's progress bar and the charts' font that the binaries share. Scene discovery and
-//! the file formats themselves are `lfformat`'s.
+//! stacks through the centre view and the bilinear EPI shift, [`cost`] the plane-sweep cost
+//! (the classical baseline's volume and a stack's network input); [`bins`] and [`laplace`] the
+//! discretisation maths, [`posterior`] the predicted distributions, [`prediction`] (with
+//! [`npz`]) the prediction files, [`truth`] the ground truth (modes, front-most mode, masks);
+//! [`metrics`] the pure metric functions and [`scene_eval`] every metric of one method on one
+//! scene; [`progress`] and [`font`] the terminal's progress bar and the charts' font that the
+//! binaries share. Scene discovery and the file formats themselves are `lfformat`'s.
 
 pub mod bins;
 pub mod cost;
@@ -22,7 +22,6 @@ pub mod prediction;
 pub mod progress;
 pub mod regions;
 pub mod scene_eval;
-pub mod stack_cost;
 pub mod stacks;
 pub mod truth;
 

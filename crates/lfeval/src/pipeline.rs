@@ -9,13 +9,14 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use indicatif::{ParallelProgressIterator, ProgressIterator};
 use lfdata::bins::Bins;
+use lfdata::lightfield::LightField;
 use lfdata::prediction::{Method, write_prediction};
 use lfdata::progress::progress;
 use lfdata::regions::load_region_truth;
 use lfdata::scene_eval::{EvalConfig, MAIN_BADPIX, PreparedTruth, SceneScores, evaluate};
 use lfdata::truth::{EtaKind, HCI_GT_FILE, Reference, SceneTruth};
 use lfformat::dataset::SceneDir;
-use lfformat::views::{LightField, centre_view};
+use lfformat::views::centre_view;
 use rayon::prelude::*;
 use serde::Serialize;
 
