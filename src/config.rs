@@ -9,6 +9,7 @@ use crate::camera::LightFieldCamera;
 use crate::output::images::ToneCurve;
 pub use crate::procgen::settings::RoomSettings as SceneConfig;
 pub use crate::render::integrator::GlassLight;
+pub use crate::render::sensor::SensorSettings as SensorConfig;
 pub use crate::render::slices::SliceAssignment;
 pub use crate::scene::SliceSpacing;
 pub use crate::scene::gltf::GltfSettings as GltfConfig;
@@ -29,6 +30,9 @@ pub struct Config {
     pub render: RenderConfig,
     pub scene: SceneConfig,
     pub gltf: GltfConfig,
+    /// The camera's imaging model (noise, vignetting, exposure and white balance), off by
+    /// default.
+    pub sensor: SensorConfig,
 }
 
 /// What is generated and where it goes.
@@ -324,6 +328,11 @@ pub const PRESETS: &[Preset] = &[
         about: "views at about 40 dB for 1.6× the time (a final gather, 2 fill spp)",
         sets: &["render.final_gather=true", "render.cache_spp=2"],
     },
+    Preset {
+        name: "camera",
+        about: "views as a camera records them: sensor noise, vignetting, exposure and white balance",
+        sets: &["sensor.enabled=true"],
+    },
 ];
 
 /// Largest samples per pixel.
@@ -498,6 +507,7 @@ impl Config {
             );
         }
         self.scene.validate()?;
+        self.sensor.validate()?;
         self.gltf.validate()
     }
 

@@ -11,6 +11,7 @@ use crate::render::RenderScene;
 use crate::render::cache::{CacheParams, RadianceCache};
 use crate::render::framing::auto_exposure;
 use crate::render::integrator::{PathSettings, Shading};
+use crate::render::sensor::SensorSettings;
 use crate::render::view::{Adaptive, RenderSettings, ViewOutput, gt_own_spp};
 use crate::scene::SceneDesc;
 use crate::scene::assets::Assets;
@@ -56,6 +57,8 @@ pub struct RenderJob {
     pub cache: CacheParams,
     /// Filter library textures over a sample's footprint (see [`PathSettings::footprint`]).
     pub texture_filter: bool,
+    /// The camera model the written views go through (off: the clean render).
+    pub sensor: SensorSettings,
 }
 
 impl RenderJob {
@@ -93,6 +96,7 @@ impl RenderJob {
                 final_gather: r.final_gather,
             },
             texture_filter: r.texture_filter,
+            sensor: cfg.sensor.clone(),
         }
     }
 
@@ -219,7 +223,9 @@ pub fn render_scene(
     root: &Path,
     samples_done: &AtomicU64,
 ) -> Result<Vec<FileEntry>> {
-    let writer = SceneWriter::create(final_dir, job.write_exr, job.tone_curve)?;
+    let writer = SceneWriter::create(final_dir, job.write_exr, job.tone_curve)?
+        .with_clean_views(job.sensor.write_clean);
+    let capture = job.sensor.capture(desc.seed, desc.index);
     let center = desc.camera.center_view();
     let per_view = job.gt_views == GtViews::All;
     // The centre view first: it fixes the exposure for all views and carries the GT.
@@ -259,12 +265,14 @@ pub fn render_scene(
         if view == center && job.auto_exposure && !adaptive {
             desc.exposure *= auto_exposure(&out.image.pixels);
         }
+        let image = &out.image;
+        let recorded = capture.map(|c| c.develop(&image.pixels, image.width, desc.exposure, view));
         writer.write_view(
             view,
-            out.image.width,
-            out.image.height,
-            &out.image.pixels,
+            (image.width, image.height),
+            &image.pixels,
             desc.exposure,
+            recorded.as_deref(),
         )?;
         if let Some(gt) = &out.gt {
             let images = GtImages {

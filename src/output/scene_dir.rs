@@ -36,6 +36,9 @@ pub struct SceneWriter {
     tone_curve: ToneCurve,
     /// High-resolution GT written at this many pixels per pixel (`depth_map_scale`), if any.
     highres_scale: Option<u32>,
+    /// Beside a view the camera model recorded, also write its clean render as
+    /// `clean_CamNNN.png`.
+    write_clean: bool,
     /// Held until the folder is published (or the writer is dropped on an error).
     _lock: Lock,
 }
@@ -80,31 +83,48 @@ impl SceneWriter {
             write_exr,
             tone_curve,
             highres_scale: None,
+            write_clean: false,
             _lock: lock,
         })
+    }
+
+    /// With `write_clean`, views given with a camera's recording keep their clean render
+    /// beside it (see [`Self::write_view`]).
+    pub fn with_clean_views(self, write_clean: bool) -> Self {
+        Self {
+            write_clean,
+            ..self
+        }
     }
 
     fn path(&self, name: &str) -> PathBuf {
         self.tmp_dir.join(name)
     }
 
-    /// `input_CamNNN.png` (and `.exr` when enabled).
+    /// `input_CamNNN.png` of the linear radiance `pixels` times `exposure` (and `.exr` of the
+    /// radiance when enabled). With `recorded`, the display-linear image a camera model made of
+    /// them, the PNG is that recording, and `clean_CamNNN.png` the clean render if asked.
     pub fn write_view(
         &self,
         view: u32,
-        width: usize,
-        height: usize,
+        (width, height): (usize, usize),
         pixels: &[Vec3],
         exposure: f32,
+        recorded: Option<&[Vec3]>,
     ) -> Result<()> {
-        write_png(
-            &self.path(&format!("input_Cam{view:03}.png")),
-            width,
-            height,
-            pixels,
-            exposure,
-            self.tone_curve,
-        )?;
+        let png = |name: &str, pixels: &[Vec3], exposure: f32| {
+            let path = self.path(&format!("{name}_Cam{view:03}.png"));
+            write_png(&path, width, height, pixels, exposure, self.tone_curve)
+        };
+        match recorded {
+            Some(recorded) => {
+                png("input", recorded, 1.0)?;
+                if self.write_clean {
+                    png("clean", pixels, exposure)?;
+                }
+            }
+            None => png("input", pixels, exposure)?,
+        }
         if self.write_exr {
             write_linear_exr(
                 &self.path(&format!("input_Cam{view:03}.exr")),
@@ -319,6 +339,7 @@ fn is_scene_file(name: &str) -> bool {
     };
     let view = name
         .strip_prefix("input_Cam")
+        .or_else(|| name.strip_prefix("clean_Cam"))
         .and_then(|r| r.strip_suffix(".png").or_else(|| r.strip_suffix(".exr")))
         .is_some_and(|n| n.len() == 3 && n.bytes().all(|b| b.is_ascii_digit()));
     FIXED.contains(&name)

@@ -17,6 +17,7 @@ pub mod integrator;
 pub mod lights;
 pub mod material;
 pub mod sampler;
+pub mod sensor;
 pub mod slices;
 pub mod valid;
 pub mod view;
