@@ -14,6 +14,8 @@ pub const MAX_RADIANCE: f64 = 1e6;
 pub const MAX_OBJECTS: u32 = 10_000;
 /// Most ceiling lights per room.
 pub const MAX_LIGHTS: u32 = 1024;
+/// Largest exposure offset either way, in stops (`scene.ev_offset`).
+pub const MAX_EV: f64 = 10.0;
 /// Largest texture library (each texture is a 768 KiB tile when used).
 pub const MAX_TEXTURES: u32 = 100_000;
 
@@ -61,6 +63,70 @@ pub struct RoomSettings {
     pub catalog_share: f64,
     /// Weights of catalogue categories (absent ones weigh 1), times each entry's own weight.
     pub category_weights: std::collections::BTreeMap<String, f64>,
+    /// How each room is lit, drawn per scene by these weights (see [`LightingWeights`]).
+    pub lighting: LightingWeights,
+    /// Probability that a light (ceiling panel, spot) has a saturated colour instead of a
+    /// white of random colour temperature.
+    pub coloured_light: f64,
+    /// Exposure offset in stops, drawn uniformly from `[min, max]` per scene and applied on
+    /// top of the automatic exposure: negative values leave a scene darker than mid grey.
+    pub ev_offset: [f64; 2],
+    /// Probability that a room surface or a piece's solid material is texture-poor: one plain
+    /// colour instead of its texture.
+    pub plain_share: f64,
+    /// Probability that a wall, ceiling, floor or painted surface takes a low-contrast
+    /// texture (smooth plaster, concrete, paint wash or paper; luminance within ±4 % of its
+    /// mean) instead of one of the library's textured families.
+    pub subtle_share: f64,
+    /// Probability that a piece's opaque dielectric material is glossy (GGX roughness
+    /// 0.02–0.12) ...
+    pub glossy_share: f64,
+    /// ... and, of the rest, that it is metallic (roughness 0.05–0.35).
+    pub metallic_share: f64,
+}
+
+/// Relative weights of the lighting moods a room is drawn with (they need not sum to 1; at
+/// least one must be positive).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LightingWeights {
+    /// Every ceiling panel on, evenly lighting the room.
+    pub even: f64,
+    /// A dim room: one ceiling panel at a tenth to a third of its power, and 1.5 stops less
+    /// exposure on top of `ev_offset`.
+    pub dim: f64,
+    /// Ceiling panels off; one spot lamp high on a wall aimed into the room (a point source:
+    /// hard shadows).
+    pub spot: f64,
+    /// Ceiling panels off; at least one window, its sky 2–5 times `window_light`: light
+    /// from the back wall and dark corners.
+    pub window: f64,
+}
+
+impl LightingWeights {
+    /// The classic generator's lighting: every room evenly lit.
+    pub const EVEN: Self = Self {
+        even: 1.0,
+        dim: 0.0,
+        spot: 0.0,
+        window: 0.0,
+    };
+
+    /// The weights in the order even, dim, spot, window.
+    pub fn as_array(&self) -> [f64; 4] {
+        [self.even, self.dim, self.spot, self.window]
+    }
+}
+
+impl Default for LightingWeights {
+    fn default() -> Self {
+        Self {
+            even: 0.4,
+            dim: 0.2,
+            spot: 0.2,
+            window: 0.2,
+        }
+    }
 }
 
 impl Default for RoomSettings {
@@ -84,6 +150,13 @@ impl Default for RoomSettings {
             catalog: String::new(),
             catalog_share: 0.5,
             category_weights: std::collections::BTreeMap::new(),
+            lighting: LightingWeights::default(),
+            coloured_light: 0.15,
+            ev_offset: [-1.5, 0.5],
+            plain_share: 0.2,
+            subtle_share: 0.4,
+            glossy_share: 0.15,
+            metallic_share: 0.1,
         }
     }
 }
@@ -153,6 +226,36 @@ impl RoomSettings {
             (self.category_weights.iter()).find(|(_, w)| !(w.is_finite() && **w >= 0.0))
         {
             bail!("scene.category_weights: {c:?} has weight {w}, expected a number >= 0");
+        }
+        self.validate_appearance()
+    }
+
+    fn validate_appearance(&self) -> Result<()> {
+        let weights = self.lighting.as_array();
+        if weights.iter().any(|w| !(w.is_finite() && *w >= 0.0))
+            || weights.iter().sum::<f64>() <= 0.0
+        {
+            bail!(
+                "scene.lighting weights must be numbers >= 0, at least one positive, got {:?}",
+                self.lighting
+            );
+        }
+        let [a, b] = self.ev_offset;
+        if !(a.is_finite() && b.is_finite() && a <= b && a >= -MAX_EV && b <= MAX_EV) {
+            bail!(
+                "scene.ev_offset must be a [min, max] range within ±{MAX_EV} stops, got {:?}",
+                self.ev_offset
+            );
+        }
+        let shares = [
+            ("coloured_light", self.coloured_light),
+            ("plain_share", self.plain_share),
+            ("subtle_share", self.subtle_share),
+            ("glossy_share", self.glossy_share),
+            ("metallic_share", self.metallic_share),
+        ];
+        if let Some((key, p)) = shares.iter().find(|(_, p)| !(0.0..=1.0).contains(p)) {
+            bail!("scene.{key} must lie in [0, 1], got {p}");
         }
         Ok(())
     }

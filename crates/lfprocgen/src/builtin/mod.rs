@@ -9,9 +9,11 @@
 //! function of the config. [`generate`] holds the order of the draws; one `Gen` carries the
 //! stream and the scene under construction through its parts, each in its own file:
 //! `palette` (materials), `shell` (room, lights, camera), `outdoors` (openings and what lies
-//! behind them) and `furnish` (pieces and their placement).
+//! behind them), `furnish` (pieces and their placement) and `look` (lighting mood, exposure
+//! offset and surface finishes, from a stream of their own).
 
 mod furnish;
+mod look;
 mod outdoors;
 mod palette;
 mod shell;
@@ -24,6 +26,7 @@ use crate::scene::{Material, Object, SceneDesc, SceneStart, Shape, SourceFile, T
 use crate::util::colour::luminance;
 use crate::util::hash::mix64;
 use glam::Vec3;
+use look::Mood;
 use rand::RngExt;
 use rand_pcg::Pcg32;
 
@@ -39,16 +42,15 @@ pub fn generate(
     index: u64,
     library: Option<&AssetLibrary>,
 ) -> SceneDesc {
-    let mut g = Gen {
-        rng: Pcg32::new(mix64(start.seed ^ mix64(index)), 0x5CE7E),
+    let mut g = Gen::new(
+        Pcg32::new(mix64(start.seed ^ mix64(index)), 0x5CE7E),
+        Pcg32::new(mix64(start.seed ^ mix64(index)), 0x1_00C5),
         room,
-        rig: &start.rig,
+        &start.rig,
         library,
-        materials: Vec::new(),
-        objects: Vec::new(),
-        sources: Vec::new(),
-        openings: Vec::new(),
-    };
+    );
+    g.mood = g.draw_mood();
+    let ev = g.draw_ev();
     let s = room;
     let size = Vec3::new(
         g.range(s.room_width),
@@ -59,6 +61,10 @@ pub fn generate(
     g.lights(size);
     let camera = g.camera(size);
     let report = g.furnish(size, &camera);
+    let lights = match g.mood {
+        Mood::Spot => vec![g.spot_lamp(size, camera.position.as_vec3())],
+        _ => Vec::new(),
+    };
     SceneDesc {
         generator: format!("lfgen {}", env!("CARGO_PKG_VERSION")),
         name: format!("scene_{index:04}"),
@@ -67,10 +73,10 @@ pub fn generate(
         camera,
         slices: start.slices,
         environment: s.environment.map(|v| v as f32),
-        exposure: start.exposure,
+        exposure: start.exposure * ev.exp2(),
         materials: g.materials,
         objects: g.objects,
-        lights: Vec::new(),
+        lights,
         placement: Some(report),
         sources: g.sources,
     }
@@ -78,6 +84,10 @@ pub fn generate(
 
 struct Gen<'a> {
     rng: Pcg32,
+    /// The stream of the scene's look (`look`), apart from `rng` so that looks can vary
+    /// without moving any other draw.
+    look: Pcg32,
+    mood: Mood,
     room: &'a RoomSettings,
     /// The camera rig the room's camera aims.
     rig: &'a LightFieldCamera,
@@ -90,7 +100,28 @@ struct Gen<'a> {
     openings: Vec<Opening>,
 }
 
-impl Gen<'_> {
+impl<'a> Gen<'a> {
+    fn new(
+        rng: Pcg32,
+        look: Pcg32,
+        room: &'a RoomSettings,
+        rig: &'a LightFieldCamera,
+        library: Option<&'a AssetLibrary>,
+    ) -> Self {
+        Self {
+            rng,
+            look,
+            mood: Mood::Even,
+            room,
+            rig,
+            library,
+            materials: Vec::new(),
+            objects: Vec::new(),
+            sources: Vec::new(),
+            openings: Vec::new(),
+        }
+    }
+
     fn range(&mut self, [a, b]: [f64; 2]) -> f32 {
         self.rng.random_range(a..=b) as f32
     }
@@ -145,18 +176,18 @@ mod tests {
     /// lfgen's default `[scene]` settings, and what its default config starts a scene with
     /// (the HCI rig: 512², 9×9 views, 100 mm lens on a 35 mm sensor, 50 mm baseline, focus at
     /// 3 m; 128 depth slices; exposure 1), with dataset seed `seed`.
-    struct Cfg {
-        scene: RoomSettings,
-        start: SceneStart,
+    pub(super) struct Cfg {
+        pub(super) scene: RoomSettings,
+        pub(super) start: SceneStart,
     }
 
     impl Cfg {
-        fn scene_start(&self) -> SceneStart {
+        pub(super) fn scene_start(&self) -> SceneStart {
             self.start.clone()
         }
     }
 
-    fn cfg(seed: u64) -> Cfg {
+    pub(super) fn cfg(seed: u64) -> Cfg {
         let rig = LightFieldCamera {
             resolution: [512, 512],
             grid: [9, 9],
@@ -186,16 +217,8 @@ mod tests {
     fn placement_is_collision_free_and_inside_the_room_on_many_seeds() {
         for seed in 0..40 {
             let c = cfg(seed);
-            let mut g = Gen {
-                rng: Pcg32::new(mix64(seed), 1),
-                room: &c.scene,
-                rig: &c.start.rig,
-                library: None,
-                materials: Vec::new(),
-                objects: Vec::new(),
-                sources: Vec::new(),
-                openings: Vec::new(),
-            };
+            let (rng, look) = (Pcg32::new(mix64(seed), 1), Pcg32::new(mix64(seed), 2));
+            let mut g = Gen::new(rng, look, &c.scene, &c.start.rig, None);
             let room = Vec3::new(
                 g.range(c.scene.room_width),
                 g.range(c.scene.room_height),

@@ -1,6 +1,7 @@
 //! Openings in the back wall and what lies behind them: the wall's reveal, a window's glass
 //! and the outdoor layers it looks out on (sky, woods, buildings, a tree), a door's corridor.
 
+use super::look::Mood;
 use super::{Gen, kelvin_rgb};
 use crate::openings::{Opening, OpeningKind, REVEAL};
 use crate::scene::{Opacity, Shape, Texture, Transform};
@@ -14,6 +15,13 @@ impl Gen<'_> {
     pub(super) fn draw_openings(&mut self, size: Vec3) -> Vec<Opening> {
         let s = self.room;
         let (door, [lo, hi]) = (s.door, s.windows);
+        // A window-lit room has a window whatever `scene.windows` says.
+        let lo = if self.mood == Mood::Window {
+            lo.max(1)
+        } else {
+            lo
+        };
+        let hi = hi.max(lo);
         let mut wanted = Vec::new();
         if self.chance(door) {
             let (w, top) = (
@@ -74,6 +82,7 @@ impl Gen<'_> {
     fn outdoors(&mut self, o: &Opening, z: f32) {
         let kelvin = self.between(5500.0, 7500.0);
         let sky = Vec3::from(kelvin_rgb(kelvin)) * self.range(self.room.window_light);
+        let sky = sky * self.window_factor();
         let face = z - REVEAL;
         let dist = self.between(1.4, 2.2);
         // Half the extent seen around the window at `d` beyond the wall's outer face.

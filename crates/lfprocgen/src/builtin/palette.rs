@@ -92,7 +92,8 @@ impl Gen<'_> {
     }
 
     /// The material of `role` for piece `name`. Roles that are solid surfaces are randomised
-    /// by the scene's shares: glass, semi-transparent with random opacity, or a grid cut-out.
+    /// by the scene's shares: plain or low-contrast, glossy or metallic (`look`), then glass,
+    /// semi-transparent with random opacity, or a grid cut-out.
     pub(super) fn role_material(&mut self, name: &str, role: Role) -> u32 {
         let name = format!("{name}_{role:?}").to_lowercase();
         let (texture, roughness, metallic) = match role {
@@ -141,6 +142,14 @@ impl Gen<'_> {
                 let all = FAMILIES;
                 (self.library(&all), 0.6, 0.0)
             }
+        };
+        let texture = match role {
+            Role::Picture => texture,
+            _ => self.surface(texture, role == Role::Paint),
+        };
+        let (roughness, metallic) = match role {
+            Role::Metal => (roughness, metallic),
+            _ => self.finish(roughness, metallic),
         };
         let mut m = self.standard(&name, texture, roughness, Opacity::constant(1.0));
         m.metallic = metallic;

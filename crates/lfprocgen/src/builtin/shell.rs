@@ -1,7 +1,7 @@
 //! The room's shell: floor, walls and ceiling with their openings, skirting boards, the
 //! ceiling lights, and the camera that looks down the room.
 
-use super::{Gen, SKIRTING, kelvin_rgb};
+use super::{Gen, SKIRTING};
 use crate::camera::LightFieldCamera;
 use crate::openings::skirting_runs;
 use crate::scene::{Opacity, Shape, Texture, Transform};
@@ -30,6 +30,9 @@ impl Gen<'_> {
         ];
         let wall_tex = self.library(&wall_families);
         let ceiling_tex = self.library(&[Family::Paint, Family::Plaster, Family::Concrete]);
+        let floor_tex = self.surface(floor_tex, true);
+        let wall_tex = self.surface(wall_tex, true);
+        let ceiling_tex = self.surface(ceiling_tex, true);
         let floor = self.standard("floor", floor_tex, 0.6, Opacity::constant(1.0));
         let floor = self.push_material(floor);
         let walls = self.standard("walls", wall_tex, 0.85, Opacity::constant(1.0));
@@ -37,6 +40,7 @@ impl Gen<'_> {
         // An accent back wall in one room out of three.
         let back = if self.chance(1.0 / 3.0) {
             let t = self.library(&wall_families);
+            let t = self.surface(t, true);
             let m = self.standard("back_wall", t, 0.85, Opacity::constant(1.0));
             self.push_material(m)
         } else {
@@ -146,13 +150,15 @@ impl Gen<'_> {
         }
     }
 
-    /// Ceiling area lights along the room, of random colour temperature and intensity.
+    /// Ceiling area lights along the room, of random colour temperature and intensity, as
+    /// bright as the room's mood has them (off, they stay as plain panels).
     pub(super) fn lights(&mut self, size: Vec3) {
         let n = self.room.lights;
         for i in 0..n {
             let kelvin = self.between(2700.0, 6500.0);
             let power = 6.0 + 10.0 * self.unit();
-            let emission = kelvin_rgb(kelvin).map(|c| c * power);
+            let factor = self.panel_factor(i);
+            let emission = self.light_rgb(kelvin, power * factor);
             let mut m = self.standard(
                 &format!("light_{i}"),
                 Texture::constant([0.8; 3]),

@@ -1,5 +1,8 @@
 //! Procedural, seamlessly tileable material textures: paint, plaster, wallpaper, tiles, bricks,
-//! planks, parquet, wood, marble, granite, concrete, carpet and woven fabric.
+//! planks, parquet, wood, marble, granite, concrete, carpet and woven fabric, and the
+//! low-contrast [`SUBTLE`] families (paint wash, paper, smooth plaster, smooth concrete) whose
+//! luminance stays within [`SUBTLE_AMPLITUDE`] of their base colour's: the texture-poor walls
+//! of real rooms, where a depth method has little to match.
 //!
 //! Every pattern is a function of (u, v) ∈ [0, 1)² that is periodic with period 1: integer
 //! repeat counts for the regular structures, and [`noise`](super::noise) whose lattice wraps
@@ -28,6 +31,10 @@ pub enum Family {
     Concrete,
     Carpet,
     Weave,
+    Wash,
+    Paper,
+    SmoothPlaster,
+    SmoothConcrete,
 }
 
 pub const FAMILIES: [Family; 14] = [
@@ -46,6 +53,22 @@ pub const FAMILIES: [Family; 14] = [
     Family::Carpet,
     Family::Weave,
 ];
+
+/// The low-contrast families, at library indices from [`SUBTLE_BASE`] on (index
+/// `SUBTLE_BASE + k` is family `SUBTLE[k % 4]`), so that the indices below it keep the
+/// textures they always had.
+pub const SUBTLE: [Family; 4] = [
+    Family::Wash,
+    Family::Paper,
+    Family::SmoothPlaster,
+    Family::SmoothConcrete,
+];
+
+/// First library index of the [`SUBTLE`] families (far above any library size).
+pub const SUBTLE_BASE: u32 = 1 << 24;
+
+/// Largest relative deviation of a [`SUBTLE`] texture's luminance from its base colour's.
+pub const SUBTLE_AMPLITUDE: f32 = 0.04;
 
 /// Everything that determines one texture; derived from its index alone.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -100,7 +123,10 @@ fn hsv(h: f32, s: f32, v: f32) -> [f32; 3] {
 impl TextureSpec {
     /// The spec of texture `index` of the library with master `seed`.
     pub fn from_index(seed: u64, index: u32) -> Self {
-        let family = FAMILIES[index as usize % FAMILIES.len()];
+        let family = match index.checked_sub(SUBTLE_BASE) {
+            Some(k) => SUBTLE[k as usize % SUBTLE.len()],
+            None => FAMILIES[index as usize % FAMILIES.len()],
+        };
         let seed = mix64(seed ^ mix64(index as u64 + 1));
         let mut d = Draw(seed);
         type Range = (f32, f32);
@@ -120,6 +146,10 @@ impl TextureSpec {
             Family::Concrete => ((0.0, 0.15), (0.0, 0.08), (0.45, 0.75), (1, 1), (1.0, 2.0)),
             Family::Carpet => ((0.0, 1.0), (0.2, 0.7), (0.2, 0.7), (1, 1), (0.4, 0.8)),
             Family::Weave => ((0.0, 1.0), (0.1, 0.6), (0.3, 0.85), (16, 48), (0.1, 0.3)),
+            Family::Wash => ((0.0, 1.0), (0.0, 0.25), (0.5, 0.9), (1, 1), (1.0, 2.0)),
+            Family::Paper => ((0.08, 0.15), (0.02, 0.15), (0.75, 0.95), (1, 1), (0.3, 0.6)),
+            Family::SmoothPlaster => ((0.05, 0.15), (0.03, 0.2), (0.6, 0.9), (1, 1), (1.0, 2.0)),
+            Family::SmoothConcrete => ((0.0, 0.15), (0.0, 0.06), (0.4, 0.7), (1, 1), (1.0, 2.0)),
         };
         let a = d.color(hue, sat, val);
         let b = d.color(hue, sat, (val.0 * 0.6, val.1 * 0.8));
@@ -157,6 +187,32 @@ impl TextureSpec {
                 a.lerp(b, fbm(u, v, 64, 2, s)) * (0.85 + 0.15 * value(u, v, 256, s + 3))
             }
             Family::Weave => weave(u, v, n, a, b, s),
+            Family::Wash | Family::Paper | Family::SmoothPlaster | Family::SmoothConcrete => {
+                a * (1.0 + SUBTLE_AMPLITUDE * subtle(self.family, u, v, s))
+            }
+        }
+    }
+}
+
+/// A low-contrast family's relative deviation from its base colour, in [−1, 1]: broad
+/// undulation plus fine grain, weighted per family (the weights of each sum to at most 1).
+fn subtle(family: Family, u: f32, v: f32, s: u64) -> f32 {
+    let signed = |x: f32| 2.0 * x - 1.0;
+    match family {
+        // Roller paint: soft blotches, a faint stipple.
+        Family::Wash => 0.7 * signed(fbm(u, v, 6, 4, s)) + 0.3 * signed(value(u, v, 256, s + 1)),
+        // Paper: fibres along u over a fine grain.
+        Family::Paper => {
+            0.5 * signed(fbm(u, v, 32, 3, s)) + 0.5 * signed(value(u, 4.0 * v % 1.0, 192, s + 1))
+        }
+        // Trowelled plaster: broad, slow strokes.
+        Family::SmoothPlaster => {
+            0.85 * signed(fbm(u, v, 3, 5, s)) + 0.15 * signed(value(u, v, 128, s + 1))
+        }
+        // Cast concrete: cloudy, with sparse small pores a little darker.
+        _ => {
+            let pores = (value(u, v, 160, s + 5) > 0.9) as u32 as f32;
+            0.7 * signed(fbm(u, v, 8, 5, s)) - 0.3 * pores
         }
     }
 }

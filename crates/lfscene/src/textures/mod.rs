@@ -20,7 +20,7 @@ pub fn render(spec: &TextureSpec, px: u32) -> Vec<glam::Vec3> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use generators::FAMILIES;
+    use generators::{FAMILIES, SUBTLE, SUBTLE_AMPLITUDE, SUBTLE_BASE};
 
     use crate::util::colour::luminance;
 
@@ -48,6 +48,44 @@ mod tests {
                 seam <= 1.1 * interior + 1e-4,
                 "{:?} (#{i}): seam {seam} vs interior {interior}",
                 spec.family
+            );
+        }
+    }
+
+    #[test]
+    fn the_subtle_families_are_seamless_low_contrast_and_not_flat() {
+        let px = 128;
+        for k in 0..SUBTLE.len() as u32 * 3 {
+            let spec = TextureSpec::from_index(0, SUBTLE_BASE + k);
+            assert_eq!(spec.family, SUBTLE[k as usize % SUBTLE.len()]);
+            let img = render(&spec, px);
+            let (seam, interior) = seam_and_interior(&img, px as usize);
+            assert!(
+                seam <= 1.1 * interior + 1e-6,
+                "{:?}: seam {seam}",
+                spec.family
+            );
+            let base = luminance(glam::Vec3::from(spec.a));
+            let rel: Vec<f32> = img.iter().map(|&c| luminance(c) / base - 1.0).collect();
+            let max = rel.iter().fold(0.0f32, |m, r| m.max(r.abs()));
+            let mean = rel.iter().sum::<f32>() / rel.len() as f32;
+            let std =
+                (rel.iter().map(|r| (r - mean).powi(2)).sum::<f32>() / rel.len() as f32).sqrt();
+            assert!(
+                max <= SUBTLE_AMPLITUDE * 1.0001,
+                "{:?}: deviation {max}",
+                spec.family
+            );
+            assert!(std > 0.002, "{:?}: flat (std {std})", spec.family);
+        }
+    }
+
+    #[test]
+    fn the_classic_library_keeps_its_families_below_the_subtle_indices() {
+        for i in 0..FAMILIES.len() as u32 * 2 {
+            assert_eq!(
+                TextureSpec::from_index(3, i).family,
+                FAMILIES[i as usize % 14]
             );
         }
     }
