@@ -329,6 +329,23 @@ pub const PRESETS: &[Preset] = &[
         sets: &["render.final_gather=true", "render.cache_spp=2"],
     },
     Preset {
+        name: "classic",
+        about: "the appearance of lfgen before its lighting moods and surface shares: evenly \
+                lit rooms exposed to mid grey, every surface textured (reproduces older datasets)",
+        sets: &[
+            "scene.lighting.even=1.0",
+            "scene.lighting.dim=0.0",
+            "scene.lighting.spot=0.0",
+            "scene.lighting.window=0.0",
+            "scene.coloured_light=0.0",
+            "scene.ev_offset=[0.0,0.0]",
+            "scene.plain_share=0.0",
+            "scene.subtle_share=0.0",
+            "scene.glossy_share=0.0",
+            "scene.metallic_share=0.0",
+        ],
+    },
+    Preset {
         name: "camera",
         about: "views as a camera records them: sensor noise, vignetting, exposure and white balance",
         sets: &["sensor.enabled=true"],
