@@ -613,14 +613,35 @@ fn write_readme(out: &Path, m: &Manifest) -> Result<()> {
         m.scenes.len(),
         splits.join(", ")
     );
-    lfformat::files::write_atomic(&out.join("README.md"), text.as_bytes())?;
     let dirs: Vec<String> = m.scenes.iter().map(|e| e.dir.clone()).collect();
-    write_summary(out, &dirs)?;
+    let summary = write_summary(out, &dirs)?;
+    let text = text + &appearance_note(summary.appearance.as_ref());
+    lfformat::files::write_atomic(&out.join("README.md"), text.as_bytes())?;
     crate::output::preview::write_preview(out, &dirs)
 }
 
+/// The README's paragraph on the centre views' appearance: median and quartiles over scenes.
+fn appearance_note(a: Option<&crate::stats::AppearanceSummary>) -> String {
+    let Some(a) = a else {
+        return String::new();
+    };
+    let q = |v: &[f64; 5], scale: f64| {
+        format!("{:.1} ({:.1}–{:.1})", v[2] * scale, v[1] * scale, v[3] * scale)
+    };
+    format!(
+        "\nAppearance of the centre views, median (quartiles) over scenes, on 8-bit luminance: \
+         local contrast (median |residual of a 3×3 mean filter|) {} levels; flat 16×16 blocks \
+         (residual std < 1.5 levels) {} %; mean luminance {}; noise σ (Immerkær) {} levels. \
+         `summary.json` has min, quartiles and max.\n",
+        q(&a.local_contrast, 1.0),
+        q(&a.flat_share, 100.0),
+        q(&a.mean_luminance, 1.0),
+        q(&a.noise, 1.0),
+    )
+}
+
 /// `summary.json`: the dataset-wide statistics over every scene's `stats.json`.
-fn write_summary(out: &Path, dirs: &[String]) -> Result<()> {
+fn write_summary(out: &Path, dirs: &[String]) -> Result<DatasetSummary> {
     let stats = dirs
         .iter()
         .map(|d| {
@@ -633,10 +654,8 @@ fn write_summary(out: &Path, dirs: &[String]) -> Result<()> {
         .collect::<Result<Vec<_>>>()?;
     let summary = DatasetSummary::new(&stats);
     let text = serde_json::to_string_pretty(&summary)? + "\n";
-    Ok(lfformat::files::write_atomic(
-        &out.join("summary.json"),
-        text.as_bytes(),
-    )?)
+    lfformat::files::write_atomic(&out.join("summary.json"), text.as_bytes())?;
+    Ok(summary)
 }
 
 #[cfg(test)]

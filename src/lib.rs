@@ -22,6 +22,7 @@ pub mod catalog {
     pub use lfformat::catalog::*;
 }
 
+pub mod appearance;
 pub mod bench;
 pub mod config;
 pub mod dataset;

@@ -1,6 +1,7 @@
 //! One scene from description to published folder: build, frame, render every view, write —
 //! for generated scenes, imported glTF scenes and saved `scene.json` files alike.
 
+use crate::appearance::ImageStats;
 use crate::camera::LightFieldCamera;
 use crate::config::{BaselineMode, Config, GtViews, ShadingMode, SliceAssignment};
 use crate::output::images::ToneCurve;
@@ -285,7 +286,13 @@ pub fn render_scene(
             writer.write_gt(view, view == center, per_view, &desc.camera, &images)?;
         }
         if view == center {
-            stats = Some(scene_stats(desc, scene, &out, job));
+            let mut s = scene_stats(desc, scene, &out, job);
+            let written = match &recorded {
+                Some(recorded) => job.tone_curve.encode(recorded, 1.0),
+                None => job.tone_curve.encode(&image.pixels, desc.exposure),
+            };
+            s.appearance = ImageStats::of_rgb8(&written, image.width, image.height);
+            stats = Some(s);
         }
     }
     writer.finish(desc, &stats.expect("centre view rendered"), root)
