@@ -5,6 +5,7 @@
 //! full disk never leaves a half-written scene under the final name.
 
 pub mod gt_files;
+pub mod hci_mask_files;
 pub mod images;
 pub mod preview;
 pub mod scene_dir;

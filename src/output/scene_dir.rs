@@ -10,6 +10,7 @@
 use super::gt_files::{
     write_depth_maps, write_ids_json, write_objectids_highres, write_surface_maps, write_valid,
 };
+use super::hci_mask_files::write_hci_masks;
 use super::images::{ToneCurve, write_linear_exr, write_png};
 use crate::camera::LightFieldCamera;
 use crate::render::view::HciLayer;
@@ -22,6 +23,7 @@ use lfformat::manifest::{FileEntry, sha256_file};
 use lfformat::modes::write_modes_exr_with_surfaces;
 use lfformat::mpi::{LOADER_LAYERS, Mpi, write_mpi_npz};
 use lfformat::params::hci_disp_bounds;
+use lfformat::region_masks::{MASK_STEMS, mask_file};
 use lfformat::{HciParameters, ModeMap, ModeSurface};
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -162,6 +164,9 @@ impl SceneWriter {
             write_surface_maps(dir, "lowres", &s, gt.hci)?;
             write_valid(dir, &s, w, h, gt.valid)?;
         }
+        if is_center {
+            write_hci_masks(dir, cam, gt.hci, 1)?;
+        }
         Ok(())
     }
 
@@ -180,6 +185,9 @@ impl SceneWriter {
         for s in gt_suffixes(view, is_center, per_view) {
             write_depth_maps(&self.tmp_dir, "highres", &s, layer, disparity)?;
             write_objectids_highres(&self.tmp_dir, &s, layer)?;
+        }
+        if is_center {
+            write_hci_masks(&self.tmp_dir, cam, layer, scale)?;
         }
         Ok(())
     }
@@ -355,6 +363,11 @@ fn is_scene_file(name: &str) -> bool {
             .any(|map| per_view(&format!("{map}_lowres"), ".png"))
         || per_view("objectids_highres", ".png")
         || per_view("valid_mask", ".png")
+        || MASK_STEMS.iter().any(|stem| {
+            [false, true]
+                .iter()
+                .any(|&high| name == mask_file(stem, high))
+        })
         || per_view("modes", ".exr")
 }
 
