@@ -2,6 +2,7 @@
 //! a part of it).
 #![allow(dead_code)]
 
+use lfformat::region_masks::{MASK_STEMS, mask_file};
 use std::collections::BTreeMap;
 use std::ffi::OsStr;
 use std::fs;
@@ -29,6 +30,7 @@ pub fn stderr(out: &Output) -> String {
 /// The files of a centre-GT scene folder with `views` views, sorted by name.
 pub fn scene_files(views: u32) -> Vec<String> {
     let mut names: Vec<String> = (0..views).map(|i| format!("input_Cam{i:03}.png")).collect();
+    names.extend(MASK_STEMS.iter().map(|stem| mask_file(stem, false)));
     names.extend(
         [
             "gt_depth_lowres.pfm",
