@@ -15,4 +15,5 @@ pub mod baseline;
 pub mod pipeline;
 pub mod report;
 pub mod robust;
+pub mod slfc;
 pub mod summary;
