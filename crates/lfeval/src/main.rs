@@ -15,6 +15,7 @@ use lfeval::baseline::{BaselineConfig, DEFAULT_TEMPERATURE, DEFAULT_WINDOW};
 use lfeval::pipeline::{self, EvalOptions};
 use lfeval::report::{self, samples::PixelRequest};
 use lfeval::robust;
+use lfeval::slfc;
 use lfformat::cli::{Generated, Workers};
 use lfformat::dataset::{PARAMETERS_FILE, SceneDir, discover};
 use lfformat::views::ViewSet;
@@ -48,6 +49,9 @@ fn command() -> clap::Command {
 enum Command {
     /// Run the classical cost-volume baseline and write its predictions.
     Baseline(BaselineArgs),
+    /// Run Sparse Light Field Coding (per-pixel Lasso over EPI atoms, several disparities per
+    /// pixel) and write its predictions; resumes an interrupted run.
+    Slfc(SlfcArgs),
     /// Write the ground truth as a method's predictions (checks a pipeline: scores 0).
     Truth(TruthArgs),
     /// Write seeded, corrupted copies of a dataset's scenes (noise, contrast, exposure,
@@ -182,6 +186,28 @@ struct BaselineArgs {
 }
 
 #[derive(Args)]
+struct SlfcArgs {
+    /// Dataset root, split folder or scene folder.
+    dataset: PathBuf,
+    /// Prediction folder to write (scenes already in it are skipped).
+    #[arg(long)]
+    out: PathBuf,
+    #[command(flatten)]
+    common: Common,
+    #[command(flatten)]
+    bins: BinArgs,
+    /// Lasso weight α of the objective 1/(2n)·‖y − D w‖² + α‖w‖₁.
+    #[arg(long, default_value_t = slfc::DEFAULT_ALPHA)]
+    alpha: f64,
+    /// EPI window radius in pixels.
+    #[arg(long, default_value_t = slfc::DEFAULT_RADIUS)]
+    radius: usize,
+    /// Lasso stopping tolerance: duality gap relative to the window's squared norm.
+    #[arg(long, default_value_t = slfc::DEFAULT_TOL)]
+    tol: f64,
+}
+
+#[derive(Args)]
 struct TruthArgs {
     /// Dataset root, split folder or scene folder.
     dataset: PathBuf,
@@ -253,6 +279,7 @@ fn run(cli: Cli) -> Result<()> {
     let quiet = cli.workers.quiet;
     match cli.command {
         Some(Command::Baseline(a)) => baseline(a, quiet),
+        Some(Command::Slfc(a)) => run_slfc(a, quiet),
         Some(Command::Truth(a)) => truth(a, quiet),
         Some(Command::Corrupt(a)) => {
             let scenes = discover(&a.dataset, &a.common.splits)?;
@@ -265,7 +292,10 @@ fn run(cli: Cli) -> Result<()> {
             bench.write(&a.out)?;
             let table = bench.table("BadPix(0.07) %", |s| s.badpix_007);
             lfformat::console::stdout(format_args!("{}", table.to_markdown()))?;
-            lfformat::note!("report written to {}", a.out.join("robustness.md").display());
+            lfformat::note!(
+                "report written to {}",
+                a.out.join("robustness.md").display()
+            );
             Ok(())
         }
         Some(Command::Generated(g)) => Ok(g.print(command())?),
@@ -313,6 +343,27 @@ fn evaluate(a: EvalArgs, quiet: bool) -> Result<()> {
     lfformat::console::stdout(format_args!("{table}"))?;
     lfformat::note!("report written to {}", a.out.join("report.html").display());
     Ok(())
+}
+
+fn run_slfc(a: SlfcArgs, quiet: bool) -> Result<()> {
+    let scenes = discover(&a.dataset, &a.common.splits)?;
+    for (name, value) in [("--alpha", a.alpha), ("--tol", a.tol)] {
+        if !(value.is_finite() && value > 0.0) {
+            anyhow::bail!("{name} must be positive, got {value}");
+        }
+    }
+    let defaults = slfc::SlfcConfig::default();
+    let cfg = slfc::SlfcConfig {
+        bins: a.bins.bins(&scenes)?,
+        radius: a.radius,
+        lasso: slfc::lasso::LassoSettings {
+            alpha: a.alpha,
+            tol: a.tol,
+            ..defaults.lasso
+        },
+        ..defaults
+    };
+    pipeline::slfc_dataset(&a.dataset, &scenes, &a.out, &cfg, quiet)
 }
 
 fn baseline(a: BaselineArgs, quiet: bool) -> Result<()> {

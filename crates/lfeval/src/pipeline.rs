@@ -7,16 +7,16 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use indicatif::{ParallelProgressIterator, ProgressIterator};
+use indicatif::{ParallelProgressIterator, ProgressBar, ProgressIterator, ProgressStyle};
 use lfdata::bins::Bins;
 use lfdata::lightfield::LightField;
-use lfdata::prediction::{Method, write_prediction};
+use lfdata::prediction::{Method, RUNTIME_DIR, write_prediction};
 use lfdata::progress::progress;
 use lfdata::regions::load_region_truth;
 use lfdata::scene_eval::{EvalConfig, MAIN_BADPIX, PreparedTruth, SceneScores, evaluate};
 use lfdata::truth::{EtaKind, HCI_GT_FILE, Reference, SceneTruth};
 use lfformat::dataset::SceneDir;
-use lfformat::views::centre_view;
+use lfformat::views::{ViewSet, centre_view};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -24,6 +24,7 @@ use crate::baseline::{self, BaselineConfig};
 use crate::report::errormap::{self, badpix_map, luminance};
 use crate::report::samples::{PixelRequest, PosteriorSample, auto_pixels};
 use crate::report::{ERROR_MAP_DIR, Evaluation, MethodResult};
+use crate::slfc::{self, SlfcConfig};
 use crate::summary::MethodSummary;
 
 /// Options of [`evaluate_dataset`] beyond the metric settings.
@@ -265,6 +266,58 @@ pub fn baseline_dataset(
         write_prediction(out, &scene.name, &pred)?;
     }
     Ok(())
+}
+
+/// Runs SLFC on every scene and writes its predictions under `out`. A scene whose runtime
+/// file exists (the last file [`write_prediction`] writes) is complete and skipped, so an
+/// interrupted run resumes where it stopped. Scenes run one after another, rows in parallel.
+pub fn slfc_dataset(
+    dataset: &Path,
+    scenes: &[SceneDir],
+    out: &Path,
+    cfg: &SlfcConfig,
+    quiet: bool,
+) -> Result<()> {
+    create_dir(out)?;
+    write_provenance(out, "slfc", dataset, cfg)?;
+    for (i, scene) in scenes.iter().enumerate() {
+        let done = out.join(RUNTIME_DIR).join(format!("{}.txt", scene.name));
+        if done.is_file() {
+            lfformat::note!("slfc: {} already predicted, skipped", scene.name);
+            continue;
+        }
+        let lf = LightField::load(&scene.path, ViewSet::Cross)?;
+        let message = format!("slfc {}/{} {}", i + 1, scenes.len(), scene.name);
+        let bar = row_progress(&message, quiet);
+        let result =
+            slfc::estimate(&lf, cfg, &bar).with_context(|| format!("{}", scene.path.display()))?;
+        bar.finish_and_clear();
+        if result.unconverged > 0 {
+            lfformat::note!(
+                "slfc: {}: {} Lasso problems stopped at {} sweeps above the tolerance",
+                scene.name,
+                result.unconverged,
+                cfg.lasso.max_sweeps
+            );
+        }
+        write_prediction(out, &scene.name, &result.prediction)?;
+    }
+    Ok(())
+}
+
+/// A progress bar over one scene's rows (SLFC takes minutes per scene).
+fn row_progress(message: &str, quiet: bool) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    let style = ProgressStyle::with_template(
+        "{msg} [{bar:30}] {pos}/{len} rows, {elapsed_precise} (eta {eta})",
+    )
+    .expect("valid template")
+    .progress_chars("=> ");
+    ProgressBar::new(0)
+        .with_style(style)
+        .with_message(message.to_string())
 }
 
 /// Settings of [`truth_dataset`], for its provenance file.
