@@ -288,6 +288,29 @@ mod tests {
         assert_eq!(four, img);
     }
 
+    /// A 3 × 1 grid turns into a 1 × 3 one: the grid is turned as each image is (see
+    /// [`rotate_source`]), and four turns give the light field back.
+    #[test]
+    fn rotation_turns_a_non_square_grid() {
+        let lf = LightField {
+            nx: 3,
+            ny: 1,
+            width: 2,
+            height: 1,
+            views: (0..3).map(|u| Some(vec![u as f32; 6])).collect(),
+            disparity_range: None,
+        };
+        let turned = lf.rotate90();
+        assert_eq!(
+            (turned.nx, turned.ny, turned.width, turned.height),
+            (1, 3, 1, 2)
+        );
+        for v in 0..3 {
+            assert_eq!(turned.view(0, v)[0], (2 - v) as f32);
+        }
+        assert_eq!(lf.rotate(4), lf);
+    }
+
     #[test]
     fn downscale_averages_blocks_and_divides_the_range() {
         // A 5 × 5 grid (view (1, 0) is off the star) of 5 × 3 views, red = x + 10 y:
