@@ -186,6 +186,10 @@ pub struct RenderConfig {
     /// Russian roulette starts after this many bounces.
     pub rr_depth: u32,
     pub gt_views: GtViews,
+    /// High-resolution HCI ground truth (`gt_disp_highres.pfm`, `gt_depth_highres.pfm`,
+    /// `objectids_highres.png`) on a grid this many times finer per side, from its
+    /// pixel-centre rays (the HCI benchmark: 10); 0: none.
+    pub gt_highres: u32,
     /// Number of depth slices S.
     pub slices: u32,
     pub slice_spacing: SliceSpacing,
@@ -253,6 +257,7 @@ impl Default for RenderConfig {
             max_depth: 5,
             rr_depth: 3,
             gt_views: GtViews::Center,
+            gt_highres: 0,
             slices: 128,
             slice_spacing: SliceSpacing::Depth,
             slice_assignment: SliceAssignment::Surface,
@@ -351,6 +356,12 @@ pub const PRESETS: &[Preset] = &[
         sets: &["sensor.enabled=true"],
     },
 ];
+
+/// Largest `render.gt_highres`: 16 makes a 512² scene's high-res layer 2 GiB.
+const MAX_GT_HIGHRES: u32 = 16;
+
+/// Memory of one high-resolution pixel: its layer (depth, normal, three ids) and PFM copies.
+const HIGHRES_PIXEL_BYTES: u64 = 40;
 
 /// Largest samples per pixel.
 pub const MAX_SPP: u32 = 1 << 16;
@@ -460,6 +471,15 @@ impl Config {
                 r.gt_spp
             );
         }
+        if r.gt_highres > MAX_GT_HIGHRES {
+            bail!(
+                "render.gt_highres must be 0 (off) to {MAX_GT_HIGHRES}, got {}",
+                r.gt_highres
+            );
+        }
+        let fine = c.resolution.map(|n| n as u64 * r.gt_highres as u64);
+        let what = format!("render.gt_highres {} ({fine:?} pixels)", r.gt_highres);
+        Budget::of_this_process()?.charge(&what, fine[0] * fine[1] * HIGHRES_PIXEL_BYTES)?;
         if r.cache_spp == 0 || r.cache_spp > MAX_SPP {
             bail!(
                 "render.cache_spp must be 1 to {MAX_SPP}, got {}",

@@ -41,6 +41,8 @@ pub struct RenderJob {
     pub gt_spp: u32,
     pub path: PathSettings,
     pub gt_views: GtViews,
+    /// High-resolution HCI ground truth at this many pixels per pixel (0: none).
+    pub gt_highres: u32,
     pub mode_epsilon: f32,
     pub write_exr: bool,
     pub tone_curve: ToneCurve,
@@ -78,6 +80,7 @@ impl RenderJob {
                 split_glass: r.split_glass,
             },
             gt_views: r.gt_views,
+            gt_highres: r.gt_highres,
             mode_epsilon: r.mode_epsilon as f32,
             write_exr: r.write_exr,
             tone_curve: r.tone_curve,
@@ -224,7 +227,7 @@ pub fn render_scene(
     root: &Path,
     samples_done: &AtomicU64,
 ) -> Result<Vec<FileEntry>> {
-    let writer = SceneWriter::create(final_dir, job.write_exr, job.tone_curve)?
+    let mut writer = SceneWriter::create(final_dir, job.write_exr, job.tone_curve)?
         .with_clean_views(job.sensor.write_clean);
     let capture = job.sensor.capture(desc.seed, desc.index);
     let center = desc.camera.center_view();
@@ -284,6 +287,11 @@ pub fn render_scene(
                 valid: &gt.valid,
             };
             writer.write_gt(view, view == center, per_view, &desc.camera, &images)?;
+            if job.gt_highres > 0 {
+                let (cam, scale) = (&desc.camera, job.gt_highres);
+                let layer = scene.render_hci_layer(cam, view, scale);
+                writer.write_highres((view, view == center, per_view), cam, &layer, scale)?;
+            }
         }
         if view == center {
             let mut s = scene_stats(desc, scene, &out, job);

@@ -1,6 +1,7 @@
 //! `preview.png` at the dataset root: one row per scene — centre view, HCI disparity, number of
-//! modes with η > 0.3, and η of the front-most mode — read back from the written files, so the
-//! sheet shows what users will load.
+//! modes with η > 0.3, η of the front-most mode, the normals, and the object ids (darkened
+//! where `valid_mask.png` is off) — read back from the written files, so the sheet shows what
+//! users will load.
 //!
 //! `lfgen preview DATASET` adds a contact sheet per scene (`previews/<scene>.png`: centre view,
 //! GT disparity, mode count, η of the second mode, a horizontal and a vertical epipolar-plane
@@ -10,6 +11,7 @@ use super::images::save_png;
 use crate::stats::MULTIMODAL_ETA;
 use anyhow::{Context, Result};
 use image::{Rgb, RgbImage};
+use lfformat::gt_maps::{read_id_png, read_normals_exr, read_valid_mask};
 use lfformat::modes::read_modes_exr;
 use lfformat::pfm::read_pfm;
 use std::path::Path;
@@ -18,10 +20,12 @@ use std::path::Path;
 const MAX_ROWS: usize = 8;
 /// Gap between panels, in pixels.
 const GAP: u32 = 4;
+/// Panels per scene.
+const PANELS: usize = 6;
 
 /// Writes `out/preview.png` from the first scenes of `scene_dirs` (relative to `out`).
 pub fn write_preview(out: &Path, scene_dirs: &[String]) -> Result<()> {
-    let rows: Vec<[RgbImage; 4]> = scene_dirs
+    let rows: Vec<[RgbImage; PANELS]> = scene_dirs
         .iter()
         .take(MAX_ROWS)
         .map(|d| scene_panels(&out.join(d)))
@@ -31,7 +35,7 @@ pub fn write_preview(out: &Path, scene_dirs: &[String]) -> Result<()> {
     };
     let (w, h) = first[0].dimensions();
     let mut sheet = RgbImage::from_pixel(
-        4 * w + 3 * GAP,
+        PANELS as u32 * (w + GAP) - GAP,
         rows.len() as u32 * (h + GAP) - GAP,
         Rgb([255; 3]),
     );
@@ -56,7 +60,7 @@ fn read_view(dir: &Path, index: u32) -> Result<RgbImage> {
         .to_rgb8())
 }
 
-fn scene_panels(dir: &Path) -> Result<[RgbImage; 4]> {
+fn scene_panels(dir: &Path) -> Result<[RgbImage; PANELS]> {
     let params = lfformat::HciParameters::read(&dir.join("parameters.cfg"))?;
     let center = (params.num_cams_y / 2) * params.num_cams_x + params.num_cams_x / 2;
     let view = read_view(dir, center)?;
@@ -83,7 +87,26 @@ fn scene_panels(dir: &Path) -> Result<[RgbImage; 4]> {
                 .map_or(0.0, |m| m.eta),
         )
     });
-    Ok([view, disparity, count, front])
+    let [normals, objects] = surface_panels(dir, w, h)?;
+    Ok([view, disparity, count, front, normals, objects])
+}
+
+/// The normals as `(n + 1) / 2` in RGB, and the object ids in hashed colours, half as bright
+/// where the pixel is not valid (black: no surface).
+fn surface_panels(dir: &Path, w: u32, h: u32) -> Result<[RgbImage; 2]> {
+    let (nw, _, n) = read_normals_exr(&dir.join("gt_normals_lowres.exr"))?;
+    let (_, _, ids) = read_id_png(&dir.join("objectids_lowres.png"))?;
+    let (_, _, valid) = read_valid_mask(&dir.join("valid_mask.png"))?;
+    let at = |x: u32, y: u32| y as usize * nw + x as usize;
+    let unit = |v: f32| ((v + 1.0) * 127.5).clamp(0.0, 255.0) as u8;
+    let normals = RgbImage::from_fn(w, h, |x, y| Rgb(n[at(x, y)].map(unit)));
+    let objects = RgbImage::from_fn(w, h, |x, y| {
+        let (id, valid) = (ids[at(x, y)] as u32, valid[at(x, y)]);
+        let hash = id.wrapping_mul(0x9E37_79B9).to_le_bytes();
+        let c = [hash[1], hash[2], hash[3]].map(|v| (v / 2 + 64) >> u8::from(!valid));
+        Rgb(if id == 0 { [0; 3] } else { c })
+    });
+    Ok([normals, objects])
 }
 
 /// Rows of an epipolar-plane image are this many pixels tall per view.
@@ -141,7 +164,7 @@ fn overview_row(dir: &Path, scene: &str, sheet: &str) -> Result<String> {
 /// The sheet of one scene folder: four panels on top, the two EPIs below.
 fn contact_sheet(dir: &Path) -> Result<RgbImage> {
     let params = lfformat::HciParameters::read(&dir.join("parameters.cfg"))?;
-    let [view, disparity, _, _] = scene_panels(dir)?;
+    let [view, disparity, ..] = scene_panels(dir)?;
     let modes = read_modes_exr(&dir.join("modes.exr"))?;
     let (w, h) = view.dimensions();
     let count = RgbImage::from_fn(w, h, |x, y| {

@@ -7,8 +7,10 @@ use exr::prelude::{
     AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, WritableImage,
     read_first_flat_layer_from_file,
 };
-use lfformat::modes::{read_modes_exr, write_modes_exr};
-use lfformat::{Error, Mode, ModeMap};
+use lfformat::modes::{
+    read_modes_exr, read_modes_exr_with_surfaces, write_modes_exr, write_modes_exr_with_surfaces,
+};
+use lfformat::{Error, Mode, ModeMap, ModeSurface};
 
 fn mode(disparity: f32, eta: f32) -> Mode {
     Mode {
@@ -134,6 +136,54 @@ fn exr_round_trip_with_twelve_modes() {
     let back = read_modes_exr(&path).unwrap();
     assert_eq!(back, map);
     assert_eq!(back.pixel(2, 0)[10].disparity, 2.0 + 10.0 / 16.0);
+}
+
+/// Surfaces travel with their modes (ids past 2^24, where f32 would round them, included);
+/// the depth-only reader reads the same map from the larger file, and a file without surface
+/// channels has no surfaces.
+#[test]
+fn exr_round_trip_with_surfaces() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("modes.exr");
+    let map = sample_map();
+    let surfaces: Vec<ModeSurface> = (0..map.total_modes() as u32)
+        .map(|i| ModeSurface {
+            normal: [i as f32 / 64.0, -0.5, 0.25],
+            object: i + 1,
+            material: (1 << 24) + 1 + i,
+            class: 7,
+        })
+        .collect();
+    write_modes_exr_with_surfaces(&path, &map, &surfaces).unwrap();
+    let (back, back_surfaces) = read_modes_exr_with_surfaces(&path).unwrap();
+    assert_eq!(back, map);
+    assert_eq!(back_surfaces, Some(surfaces));
+    assert_eq!(read_modes_exr(&path).unwrap(), map);
+    let image = read_first_flat_layer_from_file(&path).unwrap();
+    let layer = &image.layer_data;
+    assert!(channel(layer, "mode11.normal.X")[0].is_nan(), "unused slot");
+    write_modes_exr(&path, &map).unwrap();
+    assert_eq!(read_modes_exr_with_surfaces(&path).unwrap(), (map, None));
+}
+
+/// A file with some surface channels but not all is refused, naming the missing one.
+#[test]
+fn a_partial_set_of_surface_channels_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("modes.exr");
+    let channels = vec![
+        ("mode0.disparity", vec![1.0]),
+        ("mode0.depth", vec![2.0]),
+        ("mode0.eta", vec![1.0]),
+        ("mode0.eta_exact", vec![1.0]),
+        ("mode0.normal.X", vec![0.0]),
+    ];
+    write_raw_exr(&path, (1, 1), channels);
+    let e = read_modes_exr_with_surfaces(&path).unwrap_err().to_string();
+    assert!(
+        e.contains("mode0.normal.Y") && e.contains("modes.exr"),
+        "{e}"
+    );
 }
 
 #[test]

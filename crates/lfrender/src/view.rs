@@ -767,6 +767,41 @@ fn mode_surface(normal: Vec3, ids: SurfaceIds) -> ModeSurface {
 }
 
 impl RenderScene {
+    /// The HCI layer of `view` on a grid `scale` times finer in each direction, from the
+    /// pixel-centre rays of the finer grid: the HCI add-on's high-resolution ground truth
+    /// (`depth_map_scale`). Row after row in parallel; the same for any thread count.
+    pub fn render_hci_layer(&self, cam: &LightFieldCamera, view: u32, scale: u32) -> HciLayer {
+        let rays = cam.view_rays(view);
+        let to_camera = camera_frame(cam);
+        let (w, h) = (cam.width() * scale, cam.height() * scale);
+        let fine = |i: u32| (i as f32 + 0.5) / scale as f32;
+        let rows: Vec<HciLayer> = (0..h)
+            .into_par_iter()
+            .map_init(Vec::new, |hits, y| {
+                let mut row = HciLayer::default();
+                for x in 0..w {
+                    let ray = rays.ray(fine(x), fine(y));
+                    self.geometry
+                        .all_hits(ray.origin, ray.dir, f32::INFINITY, hits);
+                    let first = self.hci_hit(hits, ray.dir);
+                    let surface = first.map_or(ModeSurface::NONE, |h| {
+                        let (normal, ids) = self.hit_surface(&h, ray.dir, &to_camera);
+                        mode_surface(normal, ids)
+                    });
+                    row.push(first.map_or(f32::NAN, |h| h.t), surface);
+                }
+                row.height = 1;
+                row
+            })
+            .collect();
+        let mut layer = HciLayer {
+            width: w as usize,
+            ..HciLayer::default()
+        };
+        rows.into_iter().for_each(|row| layer.append(row));
+        layer
+    }
+
     /// HCI semantics: the first of `hits` (sorted front to back, along `dir`) with coverage
     /// ≥ 0.5.
     fn hci_hit(&self, hits: &[Hit], dir: Vec3) -> Option<Hit> {
