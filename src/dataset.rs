@@ -626,7 +626,12 @@ fn appearance_note(a: Option<&crate::stats::AppearanceSummary>) -> String {
         return String::new();
     };
     let q = |v: &[f64; 5], scale: f64| {
-        format!("{:.1} ({:.1}–{:.1})", v[2] * scale, v[1] * scale, v[3] * scale)
+        format!(
+            "{:.1} ({:.1}–{:.1})",
+            v[2] * scale,
+            v[1] * scale,
+            v[3] * scale
+        )
     };
     format!(
         "\nAppearance of the centre views, median (quartiles) over scenes, on 8-bit luminance: \
