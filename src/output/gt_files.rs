@@ -2,10 +2,10 @@
 //! object, material and class ids, the validity mask — and the scene's `ids.json`, which names
 //! every id (docs/reference/format.md, Scene folder).
 
-use crate::render::view::HciLayer;
 use crate::scene::SceneDesc;
 use crate::scene::labels::SceneClasses;
 use anyhow::Result;
+use lfformat::gt_maps::HciLayer;
 use lfformat::gt_maps::{write_id_png, write_normals_exr, write_valid_mask};
 use lfformat::pfm::{FloatImage, write_pfm};
 use serde::Serialize;

@@ -13,11 +13,11 @@ use super::gt_files::{
 use super::hci_mask_files::write_hci_masks;
 use super::images::{ToneCurve, write_linear_exr, write_png};
 use crate::camera::LightFieldCamera;
-use crate::render::view::HciLayer;
 use crate::scene::SceneDesc;
 use crate::stats::SceneStats;
 use anyhow::{Context, Result, bail};
 use glam::Vec3;
+use lfformat::gt_maps::HciLayer;
 use lfformat::lock::Lock;
 use lfformat::manifest::{FileEntry, sha256_file};
 use lfformat::modes::write_modes_exr_with_surfaces;

@@ -13,6 +13,44 @@ use image::{ImageBuffer, Luma, RgbImage};
 
 use crate::error::{Error, Result};
 
+/// The HCI single-valued layer of an image, row-major from the top-left: per pixel, the first
+/// surface with coverage ≥ 0.5 on the pixel-centre ray.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct HciLayer {
+    pub width: usize,
+    pub height: usize,
+    /// Planar depth (NaN: no surface).
+    pub depth: Vec<f32>,
+    /// Unit geometric normal in the camera frame of
+    /// [`ModeSurface::normal`](crate::ModeSurface::normal) (NaN: none).
+    pub normal: Vec<[f32; 3]>,
+    /// Object, material and class ids as in [`ModeSurface`](crate::ModeSurface) (0: none).
+    pub object: Vec<u32>,
+    pub material: Vec<u32>,
+    pub class: Vec<u32>,
+}
+
+impl HciLayer {
+    /// Appends a pixel (row-major).
+    pub fn push(&mut self, depth: f32, s: crate::ModeSurface) {
+        self.depth.push(depth);
+        self.normal.push(s.normal);
+        self.object.push(s.object);
+        self.material.push(s.material);
+        self.class.push(s.class);
+    }
+
+    /// Puts the rows of `other` below these.
+    pub fn append(&mut self, other: HciLayer) {
+        self.depth.extend(other.depth);
+        self.normal.extend(other.normal);
+        self.object.extend(other.object);
+        self.material.extend(other.material);
+        self.class.extend(other.class);
+        self.height += other.height;
+    }
+}
+
 /// Writes unit normals (x, y, z per pixel; NaN where there is no surface) as a float32 EXR
 /// whose R, G, B channels hold x, y, z, so viewers show the usual normal colours.
 pub fn write_normals_exr(path: &Path, width: usize, height: usize, n: &[[f32; 3]]) -> Result<()> {

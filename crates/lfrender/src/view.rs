@@ -11,6 +11,7 @@ use super::valid::is_valid;
 use crate::camera::{CameraRay, LightFieldCamera, ViewRays};
 use crate::scene::SliceRange;
 use glam::{Mat3, Vec2, Vec3};
+pub use lfformat::gt_maps::HciLayer;
 use lfformat::{Mode, ModeMap, ModeSurface};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -129,42 +130,6 @@ pub struct ViewGt {
     pub hci: HciLayer,
     /// Where the HCI disparity is trustworthy ([`is_valid`]).
     pub valid: Vec<bool>,
-}
-
-/// The HCI single-valued layer of an image, row-major from the top-left: per pixel, the first
-/// surface with coverage ≥ 0.5 on the pixel-centre ray.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct HciLayer {
-    pub width: usize,
-    pub height: usize,
-    /// Planar depth (NaN: no surface).
-    pub depth: Vec<f32>,
-    /// Unit geometric normal in the camera frame of [`ModeSurface::normal`] (NaN: none).
-    pub normal: Vec<[f32; 3]>,
-    /// Object, material and class ids as in [`ModeSurface`] (0: none).
-    pub object: Vec<u32>,
-    pub material: Vec<u32>,
-    pub class: Vec<u32>,
-}
-
-impl HciLayer {
-    fn push(&mut self, depth: f32, s: ModeSurface) {
-        self.depth.push(depth);
-        self.normal.push(s.normal);
-        self.object.push(s.object);
-        self.material.push(s.material);
-        self.class.push(s.class);
-    }
-
-    /// Puts the rows of `other` below these.
-    fn append(&mut self, other: HciLayer) {
-        self.depth.extend(other.depth);
-        self.normal.extend(other.normal);
-        self.object.extend(other.object);
-        self.material.extend(other.material);
-        self.class.extend(other.class);
-        self.height += other.height;
-    }
 }
 
 pub struct ViewOutput {
