@@ -13,6 +13,7 @@ pub mod dataset;
 pub mod error;
 pub mod files;
 pub mod gt_maps;
+pub mod hci_masks;
 pub mod lock;
 pub mod manifest;
 pub mod modes;

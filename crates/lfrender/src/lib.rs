@@ -12,7 +12,6 @@ mod build_boxes;
 pub mod cache;
 pub mod framing;
 pub mod geometry;
-pub mod hci_masks;
 pub mod integrator;
 pub mod lights;
 pub mod material;
