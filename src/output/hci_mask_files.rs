@@ -3,9 +3,9 @@
 //! (docs/design/ground-truth.md, "The HCI evaluation masks").
 
 use crate::camera::LightFieldCamera;
-use lfformat::hci_masks::{Pinhole, SurfaceMaps, hci_masks};
-use lfformat::gt_maps::HciLayer;
 use anyhow::Result;
+use lfformat::gt_maps::HciLayer;
+use lfformat::hci_masks::{Pinhole, SurfaceMaps, hci_masks};
 use lfformat::region_masks::{mask_file, write_mask_png};
 use std::path::Path;
 

@@ -1,8 +1,8 @@
 //! What the network reads per stack direction ([`crate::config::NetInput`]): the stack's
 //! views, or its plane-sweep cost volume over the `[dpp]` bin centres.
 
-use lfdata::lightfield::LightField;
 use lfdata::cost::cost_stack;
+use lfdata::lightfield::LightField;
 use lfdata::stacks::{Direction, Region, extract};
 
 use crate::config::{NetInput, TrainConfig};
