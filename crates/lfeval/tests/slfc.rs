@@ -2,7 +2,6 @@
 //! and a semi-transparent textured layer over a textured wall.
 
 use indicatif::ProgressBar;
-use lfdata::bins::Bins;
 use lfdata::lightfield::LightField;
 use lfdata::posterior::PosteriorForm;
 use lfeval::slfc::{SlfcConfig, estimate};
