@@ -7,9 +7,10 @@ use common::{
     Harness, Part, camera, cuboid, disparity, emitter, f_px, matte, quad, scene, settings,
 };
 use glam::{DVec3, Quat, Vec3};
+use lfformat::srgb::from_linear as linear_to_srgb;
 use lfformat::{Mode, ModeMap};
 use lfgen::camera::LightFieldCamera;
-use lfgen::output::images::{linear_to_srgb, to_srgb8};
+use lfgen::output::images::to_srgb8;
 use lfgen::render::integrator::GlassLight;
 use lfgen::render::slices::SliceAssignment;
 use lfgen::render::view::ViewGt;

@@ -1,22 +1,13 @@
 //! Colour images: linear radiance → 8-bit sRGB PNG, and optionally linear float EXR.
 
 use anyhow::{Context, Result};
-use exr::prelude::{Image, SpecificChannels, Vec2, WritableImage};
 use glam::{Mat3, Vec3};
 use image::ImageEncoder;
 use lfformat::files::write_file;
+use lfformat::rgb_exr::write_rgb_exr;
+use lfformat::srgb::from_linear as linear_to_srgb;
 use serde::{Deserialize, Serialize};
-use std::io::Cursor;
 use std::path::Path;
-
-/// The sRGB transfer function of a linear value in [0, 1].
-pub fn linear_to_srgb(v: f32) -> f32 {
-    if v <= 0.003_130_8 {
-        12.92 * v
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
-    }
-}
 
 /// 8-bit sRGB of linear radiance times `exposure`, clamped (reflectances, texture tiles).
 pub fn to_srgb8(pixels: &[Vec3], exposure: f32) -> Vec<u8> {
@@ -116,16 +107,9 @@ pub fn save_png(img: &image::RgbImage, path: &Path) -> Result<()> {
 /// Linear radiance (before exposure) as a float RGB EXR, encoded in memory for the same
 /// reason as [`save_png`].
 pub fn write_linear_exr(path: &Path, width: usize, height: usize, pixels: &[Vec3]) -> Result<()> {
-    let channels = SpecificChannels::rgb(|Vec2(x, y)| {
-        let c: Vec3 = pixels[y * width + x];
-        (c.x, c.y, c.z)
-    });
-    let mut bytes = Cursor::new(Vec::new());
-    Image::from_channels((width, height), channels)
-        .write()
-        .to_buffered(&mut bytes)
-        .with_context(|| format!("cannot encode {}", path.display()))?;
-    Ok(write_file(path, bytes.get_ref())?)
+    Ok(write_rgb_exr(path, width, height, |i| {
+        pixels[i].to_array()
+    })?)
 }
 
 #[cfg(test)]
@@ -199,6 +183,5 @@ mod tests {
     fn srgb_matches_reference_values() {
         assert_eq!(to_srgb8(&[Vec3::new(0.0, 1.0, 0.18)], 1.0), [0, 255, 118]);
         assert_eq!(to_srgb8(&[Vec3::splat(0.5)], 2.0), [255, 255, 255]);
-        assert!((linear_to_srgb(0.002) - 0.02584).abs() < 1e-5);
     }
 }

@@ -8,7 +8,7 @@
 use std::io::Cursor;
 use std::path::Path;
 
-use exr::prelude::{ReadChannels, ReadLayers, WritableImage};
+use exr::prelude::{ReadChannels, ReadLayers};
 use image::{ImageBuffer, Luma, RgbImage};
 
 use crate::error::{Error, Result};
@@ -55,17 +55,7 @@ impl HciLayer {
 /// whose R, G, B channels hold x, y, z, so viewers show the usual normal colours.
 pub fn write_normals_exr(path: &Path, width: usize, height: usize, n: &[[f32; 3]]) -> Result<()> {
     assert_eq!(n.len(), width * height, "one normal per pixel");
-    let channels = exr::prelude::SpecificChannels::rgb(|p: exr::prelude::Vec2<usize>| {
-        let [x, y, z] = n[p.y() * width + p.x()];
-        (x, y, z)
-    });
-    let image = exr::prelude::Image::from_channels((width, height), channels);
-    let mut bytes = Cursor::new(Vec::new());
-    image
-        .write()
-        .to_buffered(&mut bytes)
-        .map_err(|e| Error::format(path, e.to_string()))?;
-    crate::files::write_file(path, bytes.get_ref())
+    crate::rgb_exr::write_rgb_exr(path, width, height, |i| n[i])
 }
 
 /// Reads a normals EXR written by [`write_normals_exr`]: (width, height, normals).

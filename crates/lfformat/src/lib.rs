@@ -24,6 +24,8 @@ pub mod png;
 pub mod read;
 pub mod region_masks;
 pub mod results;
+pub mod rgb_exr;
+pub mod srgb;
 pub mod views;
 
 pub use error::{Error, Result};

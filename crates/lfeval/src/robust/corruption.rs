@@ -140,23 +140,11 @@ fn jpeg(img: &RgbImage, quality: u8) -> Result<RgbImage> {
     Ok(decoded.to_rgb8())
 }
 
-/// sRGB decoding of a value in `[0, 1]`.
-fn srgb_to_linear(v: f32) -> f32 {
-    if v <= 0.040_45 {
-        v / 12.92
-    } else {
-        ((v + 0.055) / 1.055).powf(2.4)
-    }
-}
+use lfformat::srgb::to_linear as srgb_to_linear;
 
 /// sRGB encoding of a linear value, clipped to `[0, 1]`.
 fn linear_to_srgb(v: f32) -> f32 {
-    let v = v.clamp(0.0, 1.0);
-    if v <= 0.003_130_8 {
-        12.92 * v
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
-    }
+    lfformat::srgb::from_linear(v.clamp(0.0, 1.0))
 }
 
 #[cfg(test)]

@@ -106,14 +106,7 @@ pub struct TextureImage {
 static SRGB_TO_LINEAR: LazyLock<[f32; 256]> =
     LazyLock::new(|| std::array::from_fn(|i| srgb_to_linear(i as f32 / 255.0)));
 
-/// The sRGB transfer function inverted: an encoded value in [0, 1] → linear.
-pub fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
+pub use lfformat::srgb::to_linear as srgb_to_linear;
 /// Size only: materials that hold an image are printed without millions of texels.
 impl std::fmt::Debug for TextureImage {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
