@@ -529,14 +529,8 @@ mod tests {
             }
         }
         let near_border = dilate(&border, N, N, PLANE_RADIUS);
-        for i in 0..N * N {
-            assert_eq!(
-                masks.planes[i],
-                !near_border[i],
-                "pixel {},{}",
-                i % N,
-                i / N
-            );
+        for (i, &near) in near_border.iter().enumerate() {
+            assert_eq!(masks.planes[i], !near, "pixel {},{}", i % N, i / N);
         }
         assert!(masks.planes.iter().filter(|&&p| p).count() > N * N / 2);
         assert!(
@@ -570,14 +564,14 @@ mod tests {
         let values = &values;
         for r in [0, 1, 2, 5, 9] {
             let fast = window_min(values, w, h, r);
-            for i in 0..w * h {
+            for (i, &got) in fast.iter().enumerate() {
                 let (x, y) = (i % w, i / w);
                 let xs = x.saturating_sub(r)..=(x + r).min(w - 1);
                 let ys = y.saturating_sub(r)..=(y + r).min(h - 1);
                 let brute = ys
                     .flat_map(|yy| xs.clone().map(move |xx| values[yy * w + xx]))
                     .fold(f64::INFINITY, f64::min);
-                assert_eq!(fast[i], brute, "r {r} pixel {x},{y}");
+                assert_eq!(got, brute, "r {r} pixel {x},{y}");
             }
         }
     }

@@ -43,7 +43,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let (w, h) = (97, 300);
         let pixel = |i: usize| {
-            let v = if (i / w) % 3 == 0 {
+            let v = if (i / w).is_multiple_of(3) {
                 0.5
             } else {
                 (i as f32 * 0.618).fract()

@@ -153,7 +153,7 @@ mod tests {
     use rand_pcg::Pcg64;
 
     fn rng(seed: u64) -> Pcg64 {
-        Pcg64::new(seed as u128, 0xa02b_dbf7_bb3c_0a7a_c28f_a16a_64ab_f96)
+        Pcg64::new(seed as u128, 0x0a02_bdbf_7bb3_c0a7_ac28_fa16_a64a_bf96)
     }
 
     /// A flat mid-grey image: the added noise has the asked σ (within sampling bounds of
