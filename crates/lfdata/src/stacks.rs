@@ -72,6 +72,19 @@ impl Region {
             height: lf.height,
         }
     }
+
+    /// The centred `fraction × fraction` part of a `width × height` image (rounded to whole
+    /// pixels, at least one).
+    pub fn centre(width: usize, height: usize, fraction: f64) -> Self {
+        let side = |n: usize| ((n as f64 * fraction).round() as usize).clamp(1, n);
+        let (w, h) = (side(width), side(height));
+        Self {
+            x0: (width - w) / 2,
+            y0: (height - h) / 2,
+            width: w,
+            height: h,
+        }
+    }
 }
 
 /// The stack `dir` of `lf` (a square `n × n` grid, as [`LightField::load_star`] reads) over

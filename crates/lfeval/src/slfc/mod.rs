@@ -26,6 +26,7 @@ use lfdata::bins::Bins;
 use lfdata::lightfield::LightField;
 use lfdata::posterior::{PosteriorForm, PosteriorMap};
 use lfdata::prediction::{ScenePrediction, point_estimates};
+use lfdata::stacks::Region;
 use lfformat::pfm::FloatImage;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -71,34 +72,6 @@ pub const DEFAULT_RADIUS: usize = 4;
 pub const DEFAULT_TOL: f64 = 1e-4;
 /// scikit-learn's default iteration cap.
 pub const DEFAULT_MAX_SWEEPS: usize = 1000;
-
-/// A centre crop of an image.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Region {
-    /// Left column.
-    pub x0: usize,
-    /// Top row.
-    pub y0: usize,
-    /// Columns.
-    pub width: usize,
-    /// Rows.
-    pub height: usize,
-}
-
-impl Region {
-    /// The centred `fraction × fraction` part of a `width × height` image (rounded to whole
-    /// pixels, at least one).
-    pub fn centre(width: usize, height: usize, fraction: f64) -> Self {
-        let side = |n: usize| ((n as f64 * fraction).round() as usize).clamp(1, n);
-        let (w, h) = (side(width), side(height));
-        Self {
-            x0: (width - w) / 2,
-            y0: (height - h) / 2,
-            width: w,
-            height: h,
-        }
-    }
-}
 
 /// SLFC's prediction for one scene and how many of its Lasso problems stopped at the sweep
 /// cap before reaching the tolerance.
