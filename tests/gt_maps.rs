@@ -10,9 +10,11 @@ use bin::{TINY, lfgen, ok};
 use common::{Harness, Part, camera, cuboid, disparity, matte, quad, scene, settings};
 use glam::{DVec3, Quat, Vec3};
 use lfformat::gt_maps::{read_id_png, read_normals_exr, read_valid_mask};
+use lfformat::hci_masks::{DISCONTINUITY_RADIUS, SMOOTH_RADIUS, dilate};
 use lfformat::modes::read_modes_exr_with_surfaces;
 use lfformat::pfm::read_pfm;
 use lfgen::camera::LightFieldCamera;
+use lfgen::output::hci_mask_files::centre_masks;
 use lfgen::render::RenderScene;
 use lfgen::render::view::ViewGt;
 use lfgen::scene::{SceneDesc, Shape, Transform};
@@ -158,6 +160,53 @@ fn normals_match_the_analytic_planes_within_half_a_degree() {
         checked > w * h * 3 / 4 && pure > w * h / 2,
         "{checked}, {pure}"
     );
+}
+
+/// A finely tessellated ball before a wall, through the renderer and the mask writer's own
+/// function: its interior (beyond the silhouette's bands) is a smooth surface, no plane and no
+/// edge — its facets' creases are neither — and the wall is no smooth surface.
+#[test]
+fn a_tessellated_ball_is_a_smooth_surface() {
+    let eye = DVec3::new(0.0, 1.0, 4.0);
+    let cam = camera([48, 48], [3, 3], 50.0, eye);
+    let ahead = |z: f64| (eye + DVec3::new(0.0, 0.0, -z)).as_vec3();
+    let ball = Part {
+        shape: Shape::Sphere {
+            radius: 0.35,
+            rings: 48,
+            segments: 96,
+        },
+        transform: Transform::at(ahead(1.8)),
+        material: matte([0.8, 0.3, 0.3], 1.0),
+    };
+    let wall = quad([12.0, 12.0], ahead(5.5), matte([0.6; 3], 1.0));
+    let desc = scene(cam.clone(), [1.0, 7.0], [1.0; 3], vec![ball, wall]);
+    let g = Harness::new(desc).render(cam.center_view(), &settings(1, 1), true);
+    let layer = g.gt.expect("ground truth").hci;
+    let masks = centre_masks(&cam, &layer, 1);
+    let n = 48;
+    let ball_id = layer.object[n * n / 2 + n / 2];
+    let not_ball: Vec<bool> = layer.object.iter().map(|&o| o != ball_id).collect();
+    let near_silhouette = dilate(&not_ball, n, n, DISCONTINUITY_RADIUS + SMOOTH_RADIUS);
+    let (mut interior, mut smooth) = (0, 0);
+    for (i, &near) in near_silhouette.iter().enumerate() {
+        let at = format!("pixel ({}, {})", i % n, i / n);
+        if layer.object[i] != ball_id {
+            assert!(!masks.smooth_surfaces[i], "{at}: the wall is not curved");
+            continue;
+        }
+        assert!(!masks.planes[i], "{at}: the ball is not a plane");
+        if !near {
+            assert!(
+                !masks.discontinuities[i],
+                "{at}: a facet crease taken for an edge"
+            );
+            interior += 1;
+            smooth += usize::from(masks.smooth_surfaces[i]);
+        }
+    }
+    assert!(interior > 200, "{interior} interior pixels");
+    assert_eq!(smooth, interior, "interior pixels not smooth");
 }
 
 /// Every view's ground truth of the room.

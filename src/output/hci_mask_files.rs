@@ -5,7 +5,7 @@
 use crate::camera::LightFieldCamera;
 use anyhow::Result;
 use lfformat::gt_maps::HciLayer;
-use lfformat::hci_masks::{Pinhole, SurfaceMaps, hci_masks};
+use lfformat::hci_masks::{HciMasks, Pinhole, SurfaceMaps, hci_masks};
 use lfformat::region_masks::{mask_file, write_mask_png};
 use std::path::Path;
 
@@ -17,6 +17,15 @@ pub fn write_hci_masks(
     layer: &HciLayer,
     scale: u32,
 ) -> Result<()> {
+    for (stem, mask) in centre_masks(cam, layer, scale).named() {
+        let path = dir.join(mask_file(stem, scale > 1));
+        write_mask_png(&path, layer.width, layer.height, mask)?;
+    }
+    Ok(())
+}
+
+/// The five masks of the centre view's HCI layer at `scale` pixels per low-resolution pixel.
+pub fn centre_masks(cam: &LightFieldCamera, layer: &HciLayer, scale: u32) -> HciMasks {
     let maps = SurfaceMaps {
         width: layer.width,
         height: layer.height,
@@ -32,9 +41,5 @@ pub fn write_hci_masks(
         disparity_per_inverse_depth: cam.f_px() * cam.baseline_m,
         scale: scale as usize,
     };
-    for (stem, mask) in hci_masks(&maps, &pinhole).named() {
-        let path = dir.join(mask_file(stem, scale > 1));
-        write_mask_png(&path, layer.width, layer.height, mask)?;
-    }
-    Ok(())
+    hci_masks(&maps, &pinhole)
 }

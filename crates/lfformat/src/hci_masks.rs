@@ -557,6 +557,81 @@ mod tests {
         );
     }
 
+    /// A ball of radius 0.6 centred 2.5 m ahead, in front of the wall at z = −4, with exact
+    /// normals: its nearest hit of pixel `(x, y)`'s centre ray, else the wall.
+    fn trace_ball(x: usize, y: usize, cam: &Pinhole) -> (f32, [f32; 3], u32) {
+        let (centre, radius) = ([0.0, 0.0, -2.5], 0.6);
+        let u = (x as f64 + 0.5 - cam.cx) / cam.focal_px;
+        let v = -(y as f64 + 0.5 - cam.cy) / cam.focal_px;
+        // Points t·(u, v, −1) at depth t; solve |t·d − c|² = r².
+        let d = [u, v, -1.0];
+        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        let (dd, dc, cc) = (dot(d, d), dot(d, centre), dot(centre, centre));
+        let disc = dc * dc - dd * (cc - radius * radius);
+        if disc < 0.0 {
+            return (4.0, [0.0, 0.0, 1.0], WALL);
+        }
+        let t = (dc - disc.sqrt()) / dd;
+        let n = [0, 1, 2].map(|k| ((t * d[k] - centre[k]) / radius) as f32);
+        (t as f32, n, BOX)
+    }
+
+    /// A curved surface is smooth, not planar and not an edge inside; its silhouette bands
+    /// (discontinuity and the smooth window) are left out, and the flat wall stays a plane.
+    #[test]
+    fn a_ball_is_a_smooth_surface_inside_its_silhouette() {
+        // Disparities of 5 px (wall) and 8 px (ball): the silhouette's jump is well past the
+        // slope a grazing surface is forgiven ([`CONTACT_SLOPE_PX`]).
+        let cam = Pinhole {
+            disparity_per_inverse_depth: 20.0,
+            ..camera(1)
+        };
+        let hits: Vec<_> = (0..N * N).map(|i| trace_ball(i % N, i / N, &cam)).collect();
+        let (depth, normal, object): (Vec<f32>, Vec<[f32; 3]>, Vec<u32>) = (
+            hits.iter().map(|h| h.0).collect(),
+            hits.iter().map(|h| h.1).collect(),
+            hits.iter().map(|h| h.2).collect(),
+        );
+        let maps = SurfaceMaps {
+            width: N,
+            height: N,
+            depth: &depth,
+            normal: &normal,
+            object: &object,
+        };
+        let masks = hci_masks(&maps, &cam);
+        let not_ball: Vec<bool> = object.iter().map(|&o| o != BOX).collect();
+        let band = dilate(&not_ball, N, N, DISCONTINUITY_RADIUS);
+        let near = dilate(&not_ball, N, N, DISCONTINUITY_RADIUS + SMOOTH_RADIUS);
+        let mut inside = 0;
+        for i in 0..N * N {
+            let at = format!("pixel {},{}", i % N, i / N);
+            if object[i] != BOX {
+                assert!(!masks.smooth_surfaces[i], "{at}: the wall is not curved");
+                continue;
+            }
+            assert!(!masks.planes[i], "{at}: the ball is not a plane");
+            if !near[i] {
+                assert!(
+                    masks.smooth_surfaces[i],
+                    "{at}: inside the ball, not smooth"
+                );
+                assert!(
+                    !masks.discontinuities[i],
+                    "{at}: curvature taken for an edge"
+                );
+                inside += 1;
+            }
+            if band[i] {
+                assert!(!masks.smooth_surfaces[i], "{at}: on the silhouette band");
+                assert!(masks.discontinuities[i], "{at}: the silhouette is an edge");
+            }
+        }
+        assert!(inside > 300, "{inside} interior pixels");
+        let wall_planes = (0..N * N).filter(|&i| object[i] == WALL && masks.planes[i]);
+        assert!(wall_planes.count() > N * N / 2);
+    }
+
     #[test]
     fn window_minimum_matches_brute_force() {
         let (w, h) = (13, 7);
