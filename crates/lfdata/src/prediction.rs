@@ -21,6 +21,7 @@ use lfformat::pfm::{FloatImage, read_pfm, write_pfm};
 use crate::bins::Bins;
 use crate::npz::{Array, NpzReader, write_npz};
 use crate::posterior::{PosteriorForm, PosteriorMap};
+use crate::stacks::Region;
 
 /// Folder of the disparity maps.
 pub const DISP_DIR: &str = "disp_maps";
@@ -77,33 +78,60 @@ impl Method {
 
     /// Reads the prediction for `scene` and checks it is `width × height`.
     pub fn load(&self, scene: &str, width: usize, height: usize) -> Result<ScenePrediction> {
-        let size_check = |path: &Path, w: usize, h: usize| {
-            if (w, h) != (width, height) {
-                bail!(
+        self.load_cropped(scene, width, height, None)
+    }
+
+    /// [`Method::load`], also taking a prediction the size of `crop` when one is given (a
+    /// method run on the crop only, as `lfeval slfc --crop`): such a prediction is placed
+    /// into the whole image, not-a-number around it.
+    pub fn load_cropped(
+        &self,
+        scene: &str,
+        width: usize,
+        height: usize,
+        crop: Option<Region>,
+    ) -> Result<ScenePrediction> {
+        let whole = Region {
+            x0: 0,
+            y0: 0,
+            width,
+            height,
+        };
+        let placed = |path: &Path, w: usize, h: usize| -> Result<Region> {
+            match crop {
+                _ if (w, h) == (width, height) => Ok(whole),
+                Some(c) if (w, h) == (c.width, c.height) => Ok(c),
+                Some(c) => bail!(
+                    "{}: {w}x{h}, but the ground truth is {width}x{height} and its crop {}x{}",
+                    path.display(),
+                    c.width,
+                    c.height
+                ),
+                None => bail!(
                     "{}: {w}x{h}, but the ground truth is {width}x{height}",
                     path.display()
-                );
+                ),
             }
-            Ok(())
+        };
+        let image = |path: &Path| -> Result<FloatImage> {
+            let img = read_pfm(path)?;
+            let at = placed(path, img.width, img.height)?;
+            Ok(embed_image(&img, at, width, height))
         };
         let posterior = optional(self.file(POSTERIOR_DIR, scene, "npz"), |p| {
-            let map = read_posterior_sized(p, Some([height, width]))?;
-            size_check(p, map.width, map.height)?;
-            Ok(map)
+            // Without a crop the header alone can refuse a file of the wrong size.
+            let map = match crop {
+                None => read_posterior_sized(p, Some([height, width]))?,
+                Some(_) => read_posterior(p)?,
+            };
+            let at = placed(p, map.width, map.height)?;
+            Ok(embed_posterior(&map, at, width, height))
         })?;
-        let uncertainty = optional(self.file(UNCERTAINTY_DIR, scene, "pfm"), |p| {
-            let img = read_pfm(p)?;
-            size_check(p, img.width, img.height)?;
-            Ok(img)
-        })?;
+        let uncertainty = optional(self.file(UNCERTAINTY_DIR, scene, "pfm"), image)?;
         let runtime_s = optional(self.file(RUNTIME_DIR, scene, "txt"), read_runtime)?;
         let disp_path = self.file(DISP_DIR, scene, "pfm");
         let disparity = match (disp_path.exists(), &posterior) {
-            (true, _) => {
-                let img = read_pfm(&disp_path)?;
-                size_check(&disp_path, img.width, img.height)?;
-                img
-            }
+            (true, _) => image(&disp_path)?,
             (false, Some(map)) => point_estimates(map),
             (false, None) => bail!(
                 "{}: missing, and there is no {} either",
@@ -117,6 +145,67 @@ impl Method {
             posterior,
             runtime_s,
         })
+    }
+}
+
+/// `values` (`per_pixel` per pixel of `at`, row-major) placed at `at` in a `width × height`
+/// image of `fill`.
+fn embed<T: Copy>(values: &[T], per_pixel: usize, at: Region, width: usize, fill: T) -> Vec<T> {
+    let height = at.y0 + at.height;
+    let mut out = vec![fill; width * height.max(1) * per_pixel];
+    for (y, row) in values.chunks_exact(at.width * per_pixel).enumerate() {
+        let start = ((at.y0 + y) * width + at.x0) * per_pixel;
+        out[start..start + row.len()].copy_from_slice(row);
+    }
+    out
+}
+
+/// `img`, predicted over `at`, in a `width × height` image; not-a-number outside `at`.
+fn embed_image(img: &FloatImage, at: Region, width: usize, height: usize) -> FloatImage {
+    if (img.width, img.height) == (width, height) {
+        return img.clone();
+    }
+    let mut data = embed(&img.data, 1, at, width, f32::NAN);
+    data.resize(width * height, f32::NAN);
+    FloatImage::new(width, height, data)
+}
+
+/// `map`, predicted over `at`, in a `width × height` image; outside `at` the pixels hold
+/// no distribution (zero probabilities, not-a-number Laplacians).
+fn embed_posterior(map: &PosteriorMap, at: Region, width: usize, height: usize) -> PosteriorMap {
+    if (map.width, map.height) == (width, height) {
+        return map.clone();
+    }
+    let place = |values: &[f32], per_pixel: usize, fill: f32| {
+        let mut out = embed(values, per_pixel, at, width, fill);
+        out.resize(width * height * per_pixel, fill);
+        out
+    };
+    let form = match &map.form {
+        PosteriorForm::Discrete { bins, probs } => PosteriorForm::Discrete {
+            bins: *bins,
+            probs: place(probs, bins.count, 0.0),
+        },
+        PosteriorForm::Laplace { mu, log_b } => PosteriorForm::Laplace {
+            mu: place(mu, 1, f32::NAN),
+            log_b: place(log_b, 1, f32::NAN),
+        },
+        PosteriorForm::Mixture {
+            components,
+            weights,
+            mu,
+            log_b,
+        } => PosteriorForm::Mixture {
+            components: *components,
+            weights: place(weights, *components, 0.0),
+            mu: place(mu, *components, f32::NAN),
+            log_b: place(log_b, *components, f32::NAN),
+        },
+    };
+    PosteriorMap {
+        width,
+        height,
+        form,
     }
 }
 
@@ -492,5 +581,53 @@ mod tests {
         assert_eq!(pred.disparity.data, vec![0.25, -1.0]);
         let err = method.load("s", 3, 1).unwrap_err().to_string();
         assert!(err.contains("2x1") && err.contains("3x1"), "{err}");
+    }
+
+    #[test]
+    fn a_crop_sized_posterior_is_placed_at_the_crop() {
+        let dir = tempfile::tempdir().unwrap();
+        let bins = Bins::new(0.0, 2.0, 2).unwrap();
+        // A 2×1 crop at column 1, row 1 of a 4×3 image, two bins per pixel.
+        let map = PosteriorMap {
+            width: 2,
+            height: 1,
+            form: PosteriorForm::Discrete {
+                bins,
+                probs: vec![1.0, 0.0, 0.0, 1.0],
+            },
+        };
+        std::fs::create_dir(dir.path().join(POSTERIOR_DIR)).unwrap();
+        write_posterior(&dir.path().join("posteriors/s.npz"), &map).unwrap();
+        let method = Method::new(dir.path()).unwrap();
+        let crop = Region {
+            x0: 1,
+            y0: 1,
+            width: 2,
+            height: 1,
+        };
+        let pred = method.load_cropped("s", 4, 3, Some(crop)).unwrap();
+        let d = &pred.disparity.data;
+        assert_eq!((d[5], d[6]), (0.5, 1.5));
+        assert!(
+            d.iter()
+                .enumerate()
+                .all(|(i, v)| [5, 6].contains(&i) || v.is_nan())
+        );
+        let Some(PosteriorMap {
+            width: 4,
+            height: 3,
+            form: PosteriorForm::Discrete { probs, .. },
+        }) = pred.posterior
+        else {
+            panic!("a 4x3 discrete posterior");
+        };
+        assert_eq!(&probs[10..14], &[1.0, 0.0, 0.0, 1.0]);
+        assert_eq!(probs.iter().sum::<f32>(), 2.0);
+        let other = Region { x0: 0, ..crop };
+        assert!(
+            method
+                .load_cropped("s", 4, 3, Some(Region { width: 3, ..other }))
+                .is_err()
+        );
     }
 }

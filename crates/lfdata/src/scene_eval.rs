@@ -32,6 +32,8 @@ pub struct EvalConfig {
     pub reference: Reference,
     /// Samples of the sparsification curves.
     pub sparsification_steps: usize,
+    /// Side of the scored centre crop as a fraction of the image side (1: the whole frame).
+    pub crop: f64,
 }
 
 impl Default for EvalConfig {
@@ -43,6 +45,7 @@ impl Default for EvalConfig {
             eta: EtaKind::Over,
             reference: Reference::Front,
             sparsification_steps: 100,
+            crop: 1.0,
         }
     }
 }
@@ -119,11 +122,7 @@ impl<'a> PreparedTruth<'a> {
             .collect();
         Self {
             truth,
-            frame: Frame {
-                width: truth.width(),
-                height: truth.height(),
-                border: cfg.border,
-            },
+            frame: Frame::new(truth.width(), truth.height(), cfg.border).cropped(cfg.crop),
             references,
             regions: None,
         }

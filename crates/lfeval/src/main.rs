@@ -139,6 +139,10 @@ struct EvalArgs {
     /// Pixels left out at each image side.
     #[arg(long, default_value_t = 15)]
     border: usize,
+    /// Score only the centred crop of this side, a fraction of the image side (the thesis:
+    /// 0.5); predictions may cover the whole image or only the crop.
+    #[arg(long, default_value_t = 1.0, value_parser = fraction)]
+    crop: f64,
     /// Ground truth of the summary table, sparsification and error maps.
     #[arg(long, value_enum, default_value = "front")]
     reference: Reference,
@@ -205,6 +209,19 @@ struct SlfcArgs {
     /// Lasso stopping tolerance: duality gap relative to the window's squared norm.
     #[arg(long, default_value_t = slfc::DEFAULT_TOL)]
     tol: f64,
+    /// Estimate only the centred crop of this side, a fraction of the image side (the
+    /// thesis: 0.5); evaluate with the same `--crop`.
+    #[arg(long, default_value_t = 1.0, value_parser = fraction)]
+    crop: f64,
+}
+
+/// A fraction in (0, 1].
+fn fraction(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(f) if f > 0.0 && f <= 1.0 => Ok(f),
+        Ok(f) => Err(format!("{f} is not in (0, 1]")),
+        Err(e) => Err(e.to_string()),
+    }
 }
 
 #[derive(Args)]
@@ -328,6 +345,7 @@ fn evaluate(a: EvalArgs, quiet: bool) -> Result<()> {
             eta: a.eta,
             reference: a.reference,
             sparsification_steps: a.sparsification_steps,
+            crop: a.crop,
         },
         out: a.out.clone(),
         pixels: a.pixels,
@@ -352,16 +370,15 @@ fn run_slfc(a: SlfcArgs, quiet: bool) -> Result<()> {
             anyhow::bail!("{name} must be positive, got {value}");
         }
     }
-    let defaults = slfc::SlfcConfig::default();
     let cfg = slfc::SlfcConfig {
         bins: a.bins.bins(&scenes)?,
         radius: a.radius,
         lasso: slfc::lasso::LassoSettings {
             alpha: a.alpha,
             tol: a.tol,
-            ..defaults.lasso
+            ..slfc::SlfcConfig::default().lasso
         },
-        ..defaults
+        crop: a.crop,
     };
     pipeline::slfc_dataset(&a.dataset, &scenes, &a.out, &cfg, quiet)
 }

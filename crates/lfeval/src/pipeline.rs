@@ -160,7 +160,7 @@ fn evaluate_scene(
         .map(|(rgb, _, _)| luminance(&rgb));
     let mut scores = Vec::with_capacity(methods.len());
     for method in methods {
-        let pred = method.load(&scene.name, w, h)?;
+        let pred = method.load_cropped(&scene.name, w, h, gt.frame.crop)?;
         scores.push(evaluate(&gt, &pred, cfg));
         for s in &mut samples {
             s.add(&method.name, &pred, &cfg.bins);

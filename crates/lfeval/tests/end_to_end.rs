@@ -427,3 +427,73 @@ fn corrupted_copies_and_the_robustness_table() {
             > 1000
     );
 }
+
+/// `--crop 0.5` scores only the centred 24² of the 48² scene: a prediction wrong only outside
+/// it scores zero, one written for the crop alone (disparity and Laplace posterior) is placed
+/// there, and without `--crop` that crop-sized prediction is refused by name.
+#[test]
+fn a_crop_scores_only_the_centre_and_takes_crop_sized_predictions() {
+    use lfdata::posterior::{PosteriorForm, PosteriorMap};
+    use lfdata::prediction::{ScenePrediction, write_prediction};
+    let tmp = tempfile::tempdir().unwrap();
+    let root = tmp.path();
+    let ds = root.join("dataset");
+    write_scene(&ds.join("val/scene_0000"), 1);
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let (outside, small) = (root.join("outside"), root.join("small"));
+    // Right (d = 1) on columns and rows 12..36, 3 px off around them.
+    let centre = |i: usize| (12..36).contains(&(i % SIZE)) && (12..36).contains(&(i / SIZE));
+    let wrong = (0..SIZE * SIZE).map(|i| if centre(i) { 1.0 } else { 4.0 });
+    let prediction = |size: usize, data: Vec<f32>, posterior| ScenePrediction {
+        disparity: FloatImage::new(size, size, data),
+        uncertainty: None,
+        posterior,
+        runtime_s: Some(1.0),
+    };
+    let full = prediction(SIZE, wrong.collect(), None);
+    write_prediction(&outside, "scene_0000", &full).unwrap();
+    let laplace = PosteriorMap {
+        width: 24,
+        height: 24,
+        form: PosteriorForm::Laplace {
+            mu: vec![1.0; 24 * 24],
+            log_b: vec![-3.0; 24 * 24],
+        },
+    };
+    let crop_only = prediction(24, vec![1.0; 24 * 24], Some(laplace));
+    write_prediction(&small, "scene_0000", &crop_only).unwrap();
+
+    let report = root.join("report");
+    let args = [&s(&ds), &s(&outside), &s(&small), "--out", &s(&report)];
+    lfeval(&[&args[..], &["--crop", "0.5", "--border", BORDER, "-q"]].concat());
+    let metrics: Value =
+        serde_json::from_slice(&std::fs::read(report.join("metrics.json")).unwrap()).unwrap();
+    for m in metrics["methods"].as_array().unwrap() {
+        let summary = &m["summary"];
+        for key in ["mse_x100", "badpix_007"] {
+            let v = number(summary, &["unimodal", "front", key]);
+            assert_eq!(v, 0.0, "{} {key}", m["name"]);
+        }
+    }
+    let small_kld = &metrics["methods"][1]["summary"]["kld"];
+    // Every crop pixel has a distribution; the 8×8 two-mode block lies inside the crop.
+    assert_eq!(number(small_kld, &["pixels_all"]), 24.0 * 24.0);
+    assert_eq!(number(small_kld, &["pixels_multimodal"]), 64.0);
+
+    let whole = root.join("whole");
+    let out = Command::new(env!("CARGO_BIN_EXE_lfeval"))
+        .args([&s(&ds), &s(&small), "--out", &s(&whole), "-q"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success(),
+        "a crop-sized prediction passed without --crop"
+    );
+    assert!(err.contains("scene_0000") && err.contains("24x24"), "{err}");
+    let bad = Command::new(env!("CARGO_BIN_EXE_lfeval"))
+        .args([&s(&ds), &s(&outside), "--out", &s(&whole), "--crop", "0"])
+        .output()
+        .unwrap();
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("not in (0, 1]"));
+}

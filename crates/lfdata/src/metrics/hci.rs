@@ -159,11 +159,7 @@ mod tests {
             gt[i] = g;
             pred[i] = p;
         }
-        let frame = Frame {
-            width: 5,
-            height: 5,
-            border: 1,
-        };
+        let frame = Frame::new(5, 5, 1);
         (pred, gt, frame)
     }
 
@@ -192,11 +188,7 @@ mod tests {
     fn badpix_decides_at_the_threshold_in_float32_as_the_toolkit() {
         // |0.07f32 - 0| is 0.0700000003 in f64, just above 0.07, but equal to float32(0.07):
         // the toolkit's float32 comparison calls it good.
-        let frame = Frame {
-            width: 1,
-            height: 1,
-            border: 0,
-        };
+        let frame = Frame::new(1, 1, 0);
         close(badpix(&[0.07], &[0.0], &frame, 0.07), 0.0);
         close(badpix(&[1.070_001], &[1.0], &frame, 0.07), 100.0);
     }

@@ -291,11 +291,7 @@ impl<'a> FineInputs<'a> {
             pred: Cow::Owned(zoom_nearest(pred, w, h, big_w, big_h)),
             gt,
             masks,
-            frame: Frame {
-                width: big_w,
-                height: big_h,
-                border: frame.border * HIGHRES_EVAL_SCALE,
-            },
+            frame: frame.scaled(HIGHRES_EVAL_SCALE),
             resolution: Resolution::High,
         }
     }
@@ -521,11 +517,7 @@ mod tests {
     #[test]
     fn each_score_needs_its_mask_and_fine_ones_fall_back_to_low_resolution() {
         let (w, h) = (8, 8);
-        let frame = Frame {
-            width: w,
-            height: h,
-            border: 1,
-        };
+        let frame = Frame::new(w, h, 1);
         let gt = vec![1.0f32; w * h];
         let mut pred = gt.clone();
         pred[2 * w + 2] = 1.5;

@@ -61,11 +61,7 @@ mod tests {
 
     #[test]
     fn colours_follow_the_error_and_the_frame() {
-        let frame = Frame {
-            width: 4,
-            height: 3,
-            border: 1,
-        };
+        let frame = Frame::new(4, 3, 1);
         let gt = vec![1.0f32; 12];
         let mut pred = vec![1.0f32; 12];
         pred[6] = 1.5; // inside: bad

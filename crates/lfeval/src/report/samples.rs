@@ -160,11 +160,7 @@ mod tests {
             hci: FloatImage::new(3, 3, vec![0.0; 9]),
             modes,
         };
-        let frame = Frame {
-            width: 3,
-            height: 3,
-            border: 0,
-        };
+        let frame = Frame::new(3, 3, 0);
         assert_eq!(
             auto_pixels(&truth, &frame, EtaKind::Over),
             vec![(2, 1), (1, 1)]
