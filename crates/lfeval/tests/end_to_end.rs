@@ -465,7 +465,8 @@ fn a_crop_scores_only_the_centre_and_takes_crop_sized_predictions() {
 
     let report = root.join("report");
     let args = [&s(&ds), &s(&outside), &s(&small), "--out", &s(&report)];
-    lfeval(&[&args[..], &["--crop", "0.5", "--border", BORDER, "-q"]].concat());
+    let table = lfeval(&[&args[..], &["--crop", "0.5", "--border", BORDER, "-q"]].concat());
+    assert!(table.contains("only the centred 0.5 × 0.5 crop"), "{table}");
     let metrics: Value =
         serde_json::from_slice(&std::fs::read(report.join("metrics.json")).unwrap()).unwrap();
     for m in metrics["methods"].as_array().unwrap() {

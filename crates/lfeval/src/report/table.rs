@@ -11,6 +11,7 @@ use std::path::Path;
 use anyhow::Result;
 use lfdata::metrics::hci::SCORE_NAMES;
 use lfdata::metrics::region::{REGION_SCORE_NAMES, Resolution};
+use lfdata::scene_eval::EvalConfig;
 use lfdata::truth::Reference;
 
 use super::{
@@ -170,12 +171,12 @@ pub fn main_table(eval: &Evaluation) -> Table {
         header: header.map(String::from).to_vec(),
         rows,
         note: format!(
-            "Lower is better. MSE and BadPix: mean over scenes, {}-px border left out. \
+            "Lower is better. MSE and BadPix: mean over scenes, {}. \
              KLD: nats per pixel over {} bins on [{}, {}], ε = {}, averaged over {} pixels \
              ({} unimodal, {} multimodal = at least two modes with η > 0.3). AuSE: area under \
              the sparsification error over the removed fraction 0..1, ranking by the method's \
              uncertainty (– when it gives none). Time: mean seconds per scene as reported.",
-            eval.config.border,
+            scored_pixels(&eval.config),
             eval.config.bins.count,
             eval.config.bins.min,
             eval.config.bins.max,
@@ -185,6 +186,18 @@ pub fn main_table(eval: &Evaluation) -> Table {
             pixels.pixels_multimodal,
         ),
         best_per_row: false,
+    }
+}
+
+/// Which pixels of a scene are scored, in words.
+fn scored_pixels(cfg: &EvalConfig) -> String {
+    let border = format!("{}-px border left out", cfg.border);
+    match cfg.crop < 1.0 {
+        true => format!(
+            "{border}, only the centred {} × {} crop",
+            cfg.crop, cfg.crop
+        ),
+        false => border,
     }
 }
 
