@@ -300,6 +300,7 @@ pub fn render_scene(
                 None => job.tone_curve.encode(&image.pixels, desc.exposure),
             };
             s.appearance = ImageStats::of_rgb8(&written, image.width, image.height);
+            s.camera = capture.map(|c| c.draw);
             stats = Some(s);
         }
     }

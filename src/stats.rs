@@ -4,6 +4,7 @@
 //! render timings go to the dataset's `timings.jsonl` instead.
 
 use crate::appearance::{ImageStats, quantiles};
+use crate::render::sensor::CaptureDraw;
 use crate::scene::PlacementReport;
 use lfformat::ModeMap;
 use serde::{Deserialize, Serialize};
@@ -48,6 +49,9 @@ pub struct SceneStats {
     /// ([`crate::appearance`]; absent in older datasets).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub appearance: Option<ImageStats>,
+    /// The camera model's draw for this scene (absent when the model is off).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub camera: Option<CaptureDraw>,
 }
 
 impl SceneStats {
@@ -97,6 +101,7 @@ impl SceneStats {
             date: String::new(),
             placement: None,
             appearance: None,
+            camera: None,
         }
     }
 }

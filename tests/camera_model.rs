@@ -30,4 +30,34 @@ fn camera_views_are_seeded_and_the_clean_views_are_the_plain_render() {
         views += 1;
     }
     assert_eq!(views, 2 * 9);
+    // Each scene's draw is in its stats.json, within the preset's ranges; a plain run has none.
+    let stats = |set: &std::collections::BTreeMap<String, Vec<u8>>| -> Vec<serde_json::Value> {
+        let all = set.iter().filter(|(p, _)| p.ends_with("stats.json"));
+        all.map(|(_, b)| serde_json::from_slice(b).unwrap())
+            .collect()
+    };
+    let draws: Vec<serde_json::Value> = stats(&one)
+        .into_iter()
+        .map(|s| s["camera"].clone())
+        .collect();
+    assert_eq!(draws.len(), 2);
+    for d in &draws {
+        let n = |key: &str| {
+            d[key]
+                .as_f64()
+                .unwrap_or_else(|| panic!("camera.{key} in {d}"))
+        };
+        assert!((100.0..=1600.0).contains(&n("iso")), "{d}");
+        assert!(
+            n("exposure_ev").abs() <= 0.5 && (0.0..=0.5).contains(&n("vignetting")),
+            "{d}"
+        );
+        let wb = d["white_balance_ev"].as_array().unwrap();
+        assert!(
+            wb.len() == 2 && wb.iter().all(|v| v.as_f64().unwrap().abs() <= 0.15),
+            "{d}"
+        );
+    }
+    assert_ne!(draws[0], draws[1], "each scene draws its own capture");
+    assert!(stats(&plain).iter().all(|s| s.get("camera").is_none()));
 }

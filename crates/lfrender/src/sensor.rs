@@ -81,6 +81,21 @@ pub struct Capture {
     pub read_sigma: f32,
     /// Seeds the per-pixel noise.
     pub seed: u64,
+    /// The draw in a camera's terms, for the scene's `stats.json`.
+    pub draw: CaptureDraw,
+}
+
+/// One scene's capture in a camera's terms: what the views were exposed and developed with.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CaptureDraw {
+    /// Sensor sensitivity.
+    pub iso: f64,
+    /// Exposure error, stops.
+    pub exposure_ev: f64,
+    /// White balance of the red and blue channels against green, stops.
+    pub white_balance_ev: [f64; 2],
+    /// Share of the centre's light the image corners lose to vignetting.
+    pub vignetting: f64,
 }
 
 impl SensorSettings {
@@ -126,21 +141,23 @@ impl SensorSettings {
         let key = mix64(seed ^ mix64(index ^ 0x5e75_0a11));
         let uniform =
             |k: u64, [lo, hi]: [f64; 2]| lo + (hi - lo) * unit_float(mix64(key ^ mix64(k))) as f64;
-        let jitter = |k: u64, ev: f64| 2f64.powf(uniform(k, [-ev, ev])) as f32;
-        let log_iso = uniform(1, self.iso.map(f64::ln));
-        let electrons = self.electrons_at_white * 100.0 / log_iso.exp();
-        let lost = uniform(2, self.vignetting);
-        let wb = Vec3::new(
-            jitter(3, self.white_balance_jitter_ev),
-            1.0,
-            jitter(4, self.white_balance_jitter_ev),
-        );
+        let jitter = |k: u64, ev: f64| uniform(k, [-ev, ev]);
+        let draw = CaptureDraw {
+            iso: uniform(1, self.iso.map(f64::ln)).exp(),
+            exposure_ev: jitter(5, self.exposure_jitter_ev),
+            white_balance_ev: [3, 4].map(|k| jitter(k, self.white_balance_jitter_ev)),
+            vignetting: uniform(2, self.vignetting),
+        };
+        let gain = |ev: f64| 2f64.powf(ev) as f32;
+        let [red, blue] = draw.white_balance_ev.map(gain);
+        let electrons = self.electrons_at_white * 100.0 / draw.iso;
         Some(Capture {
-            gain: wb * jitter(5, self.exposure_jitter_ev),
-            vignetting_t2: ((1.0 - lost).powf(-0.5) - 1.0) as f32,
+            gain: Vec3::new(red, 1.0, blue) * gain(draw.exposure_ev),
+            vignetting_t2: ((1.0 - draw.vignetting).powf(-0.5) - 1.0) as f32,
             electrons: electrons as f32,
             read_sigma: (self.read_noise / electrons) as f32,
             seed: mix64(key ^ 6),
+            draw,
         })
     }
 }
@@ -256,6 +273,12 @@ mod tests {
             electrons: f32::INFINITY,
             read_sigma: 0.0,
             seed: 1,
+            draw: CaptureDraw {
+                iso: 100.0,
+                exposure_ev: 0.0,
+                white_balance_ev: [0.0; 2],
+                vignetting: lost.into(),
+            },
         };
         let w = 201;
         let out = cap.develop(&vec![Vec3::ONE; w * w], w, 1.0, 0);
