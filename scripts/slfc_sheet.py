@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Thesis Figure 5.6 as a sheet: per held-out scene, the centre view's crop, the front-most
-ground-truth disparity, and the point estimates of each method given (SLFC's strongest
-coefficient, DPP's most probable bin, ...) on one colour scale, with each method's BadPix(0.07)
+ground-truth disparity, and the point estimates of each method given (SLFC's and DPP's
+most probable bin, ...) on one colour scale, with each method's BadPix(0.07)
 over the crop under its map.
 
     python3 -m pip install numpy pillow
