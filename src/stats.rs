@@ -4,9 +4,9 @@
 //! render timings go to the dataset's `timings.jsonl` instead.
 
 use crate::appearance::{ImageStats, quantiles};
-use crate::render::sensor::CaptureDraw;
 use crate::scene::PlacementReport;
 use lfformat::ModeMap;
+use lfformat::views::CaptureDraw;
 use serde::{Deserialize, Serialize};
 
 /// η above which a mode counts towards "multimodal" (thesis §5.3.2).

@@ -1,13 +1,28 @@
 //! The views of a scene folder (`input_CamNNN.png`): the subsets of the view grid that
-//! evaluation baselines and training read, and the reader of one view as RGB in `[0, 1]`.
+//! evaluation baselines and training read, the reader of one view as RGB in `[0, 1]`, and
+//! the camera-model draw the views went through.
 
 use std::io::BufReader;
 use std::path::Path;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::dataset::PARAMETERS_FILE;
 use crate::{Error, HciParameters, Result};
+
+/// One scene's capture by the camera model, in a camera's terms: what its views were exposed
+/// and developed with (`stats.json`'s `camera`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CaptureDraw {
+    /// Sensor sensitivity.
+    pub iso: f64,
+    /// Exposure error, stops.
+    pub exposure_ev: f64,
+    /// White balance of the red and blue channels against green, stops.
+    pub white_balance_ev: [f64; 2],
+    /// Share of the centre's light the image corners lose to vignetting.
+    pub vignetting: f64,
+}
 
 /// A subset of the view grid (the views a cost volume or a network reads).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

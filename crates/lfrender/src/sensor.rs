@@ -24,6 +24,7 @@
 use crate::util::hash::{mix64, unit_float};
 use anyhow::{Result, bail};
 use glam::Vec3;
+pub use lfformat::views::CaptureDraw;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -83,19 +84,6 @@ pub struct Capture {
     pub seed: u64,
     /// The draw in a camera's terms, for the scene's `stats.json`.
     pub draw: CaptureDraw,
-}
-
-/// One scene's capture in a camera's terms: what the views were exposed and developed with.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct CaptureDraw {
-    /// Sensor sensitivity.
-    pub iso: f64,
-    /// Exposure error, stops.
-    pub exposure_ev: f64,
-    /// White balance of the red and blue channels against green, stops.
-    pub white_balance_ev: [f64; 2],
-    /// Share of the centre's light the image corners lose to vignetting.
-    pub vignetting: f64,
 }
 
 impl SensorSettings {
