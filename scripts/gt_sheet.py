@@ -16,17 +16,9 @@ import numpy as np
 import OpenEXR
 from PIL import Image, ImageDraw
 
+from pfm import read_pfm
+
 MASKS = ["discontinuities", "planes", "smooth_surfaces", "fine", "fine_surrounding"]
-
-
-def read_pfm(path):
-    """HCI PFM: a greyscale float map stored bottom row first."""
-    with open(path, "rb") as f:
-        assert f.readline().strip() == b"Pf", f"{path}: not a greyscale PFM"
-        w, h = map(int, f.readline().split())
-        scale = float(f.readline())
-        data = np.frombuffer(f.read(), dtype="<f4" if scale < 0 else ">f4")
-    return np.flipud(data.reshape(h, w))
 
 
 def read_normals(path):

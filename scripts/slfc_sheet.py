@@ -12,30 +12,24 @@ A method's maps may cover the whole image or only the crop (as `lfeval slfc --cr
 the ground truth is cropped to the same centred square as `lfeval --crop` scores.
 """
 import argparse
+import math
 from pathlib import Path
 
 import numpy as np
 from PIL import Image, ImageDraw
 
+from pfm import read_pfm
+
 CELL = 192  # pixels per map on the sheet
 LABEL = 18  # height of a caption line
-
-
-def read_pfm(path):
-    """HCI PFM: a greyscale float map stored bottom row first."""
-    with open(path, "rb") as f:
-        assert f.readline().strip() == b"Pf", f"{path}: not a greyscale PFM"
-        w, h = map(int, f.readline().split())
-        scale = float(f.readline())
-        data = np.frombuffer(f.read(), dtype="<f4" if scale < 0 else ">f4")
-    return np.flipud(data.reshape(h, w))
 
 
 def centre_crop(shape, fraction):
     """Rows and columns of the centred crop, rounded as lfdata's Region::centre."""
     h, w = shape
-    ch = min(max(int(round(h * fraction)), 1), h)
-    cw = min(max(int(round(w * fraction)), 1), w)
+    # Rust's f64::round rounds halves away from zero, Python's round to even.
+    ch = min(max(math.floor(h * fraction + 0.5), 1), h)
+    cw = min(max(math.floor(w * fraction + 0.5), 1), w)
     y0, x0 = (h - ch) // 2, (w - cw) // 2
     return slice(y0, y0 + ch), slice(x0, x0 + cw)
 
