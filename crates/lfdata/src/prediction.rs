@@ -116,7 +116,7 @@ impl Method {
         let image = |path: &Path| -> Result<FloatImage> {
             let img = read_pfm(path)?;
             let at = placed(path, img.width, img.height)?;
-            Ok(embed_image(&img, at, width, height))
+            Ok(embed_image(img, at, width, height))
         };
         let posterior = optional(self.file(POSTERIOR_DIR, scene, "npz"), |p| {
             // Without a crop the header alone can refuse a file of the wrong size.
@@ -125,7 +125,7 @@ impl Method {
                 Some(_) => read_posterior(p)?,
             };
             let at = placed(p, map.width, map.height)?;
-            Ok(embed_posterior(&map, at, width, height))
+            Ok(embed_posterior(map, at, width, height))
         })?;
         let uncertainty = optional(self.file(UNCERTAINTY_DIR, scene, "pfm"), image)?;
         let runtime_s = optional(self.file(RUNTIME_DIR, scene, "txt"), read_runtime)?;
@@ -150,9 +150,15 @@ impl Method {
 
 /// `values` (`per_pixel` per pixel of `at`, row-major) placed at `at` in a `width × height`
 /// image of `fill`.
-fn embed<T: Copy>(values: &[T], per_pixel: usize, at: Region, width: usize, fill: T) -> Vec<T> {
-    let height = at.y0 + at.height;
-    let mut out = vec![fill; width * height.max(1) * per_pixel];
+fn embed<T: Copy>(
+    values: &[T],
+    per_pixel: usize,
+    at: Region,
+    width: usize,
+    height: usize,
+    fill: T,
+) -> Vec<T> {
+    let mut out = vec![fill; width * height * per_pixel];
     for (y, row) in values.chunks_exact(at.width * per_pixel).enumerate() {
         let start = ((at.y0 + y) * width + at.x0) * per_pixel;
         out[start..start + row.len()].copy_from_slice(row);
@@ -161,25 +167,22 @@ fn embed<T: Copy>(values: &[T], per_pixel: usize, at: Region, width: usize, fill
 }
 
 /// `img`, predicted over `at`, in a `width × height` image; not-a-number outside `at`.
-fn embed_image(img: &FloatImage, at: Region, width: usize, height: usize) -> FloatImage {
+fn embed_image(img: FloatImage, at: Region, width: usize, height: usize) -> FloatImage {
     if (img.width, img.height) == (width, height) {
-        return img.clone();
+        return img;
     }
-    let mut data = embed(&img.data, 1, at, width, f32::NAN);
-    data.resize(width * height, f32::NAN);
+    let data = embed(&img.data, 1, at, width, height, f32::NAN);
     FloatImage::new(width, height, data)
 }
 
 /// `map`, predicted over `at`, in a `width × height` image; outside `at` the pixels hold
 /// no distribution (zero probabilities, not-a-number Laplacians).
-fn embed_posterior(map: &PosteriorMap, at: Region, width: usize, height: usize) -> PosteriorMap {
+fn embed_posterior(map: PosteriorMap, at: Region, width: usize, height: usize) -> PosteriorMap {
     if (map.width, map.height) == (width, height) {
-        return map.clone();
+        return map;
     }
     let place = |values: &[f32], per_pixel: usize, fill: f32| {
-        let mut out = embed(values, per_pixel, at, width, fill);
-        out.resize(width * height * per_pixel, fill);
-        out
+        embed(values, per_pixel, at, width, height, fill)
     };
     let form = match &map.form {
         PosteriorForm::Discrete { bins, probs } => PosteriorForm::Discrete {

@@ -431,28 +431,31 @@ mod tests {
         (best.0 as f32, best.1, best.2)
     }
 
-    fn room(scale: usize) -> Room {
-        let cam = camera(scale);
-        let n = N * scale;
-        let hits: Vec<_> = (0..n * n).map(|i| trace(i % n, i / n, &cam)).collect();
-        Room {
+    /// The maps of the scene `trace` sees through `cam` (`n × n` pixels) and their masks.
+    fn traced(
+        n: usize,
+        cam: &Pinhole,
+        trace: fn(usize, usize, &Pinhole) -> (f32, [f32; 3], u32),
+    ) -> (Room, HciMasks) {
+        let hits: Vec<_> = (0..n * n).map(|i| trace(i % n, i / n, cam)).collect();
+        let room = Room {
             depth: hits.iter().map(|h| h.0).collect(),
             normal: hits.iter().map(|h| h.1).collect(),
             object: hits.iter().map(|h| h.2).collect(),
-        }
-    }
-
-    fn masks(scale: usize) -> (Room, HciMasks) {
-        let room = room(scale);
+        };
         let maps = SurfaceMaps {
-            width: N * scale,
-            height: N * scale,
+            width: n,
+            height: n,
             depth: &room.depth,
             normal: &room.normal,
             object: &room.object,
         };
-        let masks = hci_masks(&maps, &camera(scale));
+        let masks = hci_masks(&maps, cam);
         (room, masks)
+    }
+
+    fn masks(scale: usize) -> (Room, HciMasks) {
+        traced(N * scale, &camera(scale), trace)
     }
 
     /// The analytic depth edges: neighbours on different objects whose disparities differ by
@@ -586,20 +589,8 @@ mod tests {
             disparity_per_inverse_depth: 20.0,
             ..camera(1)
         };
-        let hits: Vec<_> = (0..N * N).map(|i| trace_ball(i % N, i / N, &cam)).collect();
-        let (depth, normal, object): (Vec<f32>, Vec<[f32; 3]>, Vec<u32>) = (
-            hits.iter().map(|h| h.0).collect(),
-            hits.iter().map(|h| h.1).collect(),
-            hits.iter().map(|h| h.2).collect(),
-        );
-        let maps = SurfaceMaps {
-            width: N,
-            height: N,
-            depth: &depth,
-            normal: &normal,
-            object: &object,
-        };
-        let masks = hci_masks(&maps, &cam);
+        let (ball, masks) = traced(N, &cam, trace_ball);
+        let object = &ball.object;
         let not_ball: Vec<bool> = object.iter().map(|&o| o != BOX).collect();
         let band = dilate(&not_ball, N, N, DISCONTINUITY_RADIUS);
         let near = dilate(&not_ball, N, N, DISCONTINUITY_RADIUS + SMOOTH_RADIUS);
