@@ -410,7 +410,7 @@ mod tests {
     }
 
     /// Nearest hit of pixel `(x, y)`'s centre ray: (depth, normal, object).
-    fn trace(x: usize, y: usize, cam: &Pinhole) -> (f32, [f32; 3], u32) {
+    fn trace(x: usize, y: usize, cam: &Pinhole) -> Hit {
         let u = (x as f64 + 0.5 - cam.cx) / cam.focal_px;
         let v = -(y as f64 + 0.5 - cam.cy) / cam.focal_px;
         // Point at depth z: (u z, v z, −z).
@@ -431,11 +431,14 @@ mod tests {
         (best.0 as f32, best.1, best.2)
     }
 
+    /// What a pixel-centre ray sees: (depth, normal, object).
+    type Hit = (f32, [f32; 3], u32);
+
     /// The maps of the scene `trace` sees through `cam` (`n × n` pixels) and their masks.
     fn traced(
         n: usize,
         cam: &Pinhole,
-        trace: fn(usize, usize, &Pinhole) -> (f32, [f32; 3], u32),
+        trace: fn(usize, usize, &Pinhole) -> Hit,
     ) -> (Room, HciMasks) {
         let hits: Vec<_> = (0..n * n).map(|i| trace(i % n, i / n, cam)).collect();
         let room = Room {
@@ -562,7 +565,7 @@ mod tests {
 
     /// A ball of radius 0.6 centred 2.5 m ahead, in front of the wall at z = −4, with exact
     /// normals: its nearest hit of pixel `(x, y)`'s centre ray, else the wall.
-    fn trace_ball(x: usize, y: usize, cam: &Pinhole) -> (f32, [f32; 3], u32) {
+    fn trace_ball(x: usize, y: usize, cam: &Pinhole) -> Hit {
         let (centre, radius) = ([0.0, 0.0, -2.5], 0.6);
         let u = (x as f64 + 0.5 - cam.cx) / cam.focal_px;
         let v = -(y as f64 + 0.5 - cam.cy) / cam.focal_px;
