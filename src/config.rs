@@ -348,6 +348,7 @@ pub const PRESETS: &[Preset] = &[
             "scene.subtle_share=0.0",
             "scene.glossy_share=0.0",
             "scene.metallic_share=0.0",
+            "scene.catalog=\"\"",
         ],
     },
     Preset {
@@ -384,7 +385,39 @@ fn origin(path: Option<&Path>, presets: &[String], sets: &[String]) -> String {
     origin
 }
 
+/// Where `lfgen assets fetch sweethome3d` writes its catalogue (relative to the working
+/// folder), which `scene.catalog = "auto"` draws from when it exists.
+pub const SWEETHOME3D_CATALOG: &str = "assets/sweethome3d/catalog.json";
+
 impl Config {
+    /// Resolves `scene.catalog = "auto"` against `dir` (the working folder): the Sweet Home 3D
+    /// catalogue of [`SWEETHOME3D_CATALOG`] if it exists, else procedural furniture only.
+    /// Returns a line saying which, for the user (None: the catalogue was named explicitly).
+    /// Resolved before the dataset is opened, so the manifest's config (and its hash, which
+    /// `--resume` and shards compare) names the catalogue that was used.
+    pub fn resolve_catalog(&mut self, dir: &Path) -> Option<String> {
+        if self.scene.catalog != crate::procgen::settings::AUTO_CATALOG {
+            return None;
+        }
+        let found = dir.join(SWEETHOME3D_CATALOG).is_file();
+        self.scene.catalog = if found {
+            SWEETHOME3D_CATALOG.into()
+        } else {
+            String::new()
+        };
+        Some(if found {
+            format!(
+                "drawing pieces from the Sweet Home 3D catalogue {SWEETHOME3D_CATALOG} \
+                 (scene.catalog=\"\" for procedural furniture only)"
+            )
+        } else {
+            format!(
+                "procedural furniture only: no {SWEETHOME3D_CATALOG} (`lfgen assets fetch \
+                 sweethome3d` installs real models there)"
+            )
+        })
+    }
+
     /// Loads `path` (or the built-in defaults when `None`), then applies presets and overrides.
     pub fn load(path: Option<&Path>, presets: &[String], sets: &[String]) -> Result<Self> {
         let mut table = match path {

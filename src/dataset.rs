@@ -177,6 +177,9 @@ fn open_library(cfg: &Config, strict: bool) -> Result<Option<AssetLibrary>> {
     if cfg.scene.catalog.is_empty() {
         return Ok(None);
     }
+    if cfg.scene.catalog == crate::procgen::settings::AUTO_CATALOG {
+        bail!("scene.catalog = \"auto\": call Config::resolve_catalog before generating");
+    }
     let path = Path::new(&cfg.scene.catalog);
     lfformat::note!("checking the asset catalogue {} …", path.display());
     let library = AssetLibrary::open(path, strict)?;

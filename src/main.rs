@@ -376,6 +376,9 @@ const MAX_SCENES: u64 = 10_000_000;
 
 fn generate(a: GenerateArgs) -> Result<()> {
     let mut cfg = load(&a.common)?;
+    if let Some(line) = cfg.resolve_catalog(Path::new(".")) {
+        lfformat::note!("{line}");
+    }
     if let Some(seed) = a.seed {
         cfg.dataset.seed = seed;
     }

@@ -344,3 +344,70 @@ fn a_catalogue_named_relative_to_the_working_folder_is_read() {
         "{err}"
     );
 }
+
+/// Copies the folder `from` into `to` (created), files and subfolders.
+fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let entry = entry.unwrap();
+        let target = to.join(entry.file_name());
+        if entry.file_type().unwrap().is_dir() {
+            copy_tree(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), &target).unwrap();
+        }
+    }
+}
+
+/// The default `scene.catalog = "auto"` draws from `assets/sweethome3d/catalog.json` where
+/// `lfgen assets fetch sweethome3d` puts it, says so, and records the resolved path in the
+/// manifest's config; without that file it says the furniture is procedural and records "".
+#[test]
+fn the_default_catalogue_is_sweet_home_3d_when_installed() {
+    for installed in [true, false] {
+        let dir = tempfile::tempdir().unwrap();
+        if installed {
+            copy_tree(&fixtures(), &dir.path().join("assets/sweethome3d"));
+        }
+        let r = Command::new(env!("CARGO_BIN_EXE_lfgen"))
+            .current_dir(dir.path())
+            .args(["--no-config", "--scenes", "1", "--out", "ds"])
+            .args([
+                "--set",
+                "camera.resolution=[16,12]",
+                "--set",
+                "camera.grid=[1,1]",
+            ])
+            .args(["--set", "render.spp=1", "--set", "render.adaptive_spp=0"])
+            .output()
+            .unwrap();
+        let err = stderr(&r);
+        assert!(r.status.success(), "{err}");
+        let manifest: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.path().join("ds/manifest.json")).unwrap())
+                .unwrap();
+        let recorded = &manifest["config"]["scene"]["catalog"];
+        if installed {
+            assert!(err.contains("Sweet Home 3D catalogue"), "{err}");
+            assert!(err.contains("4 assets usable, 9 skipped"), "{err}");
+            assert_eq!(recorded, "assets/sweethome3d/catalog.json");
+            let stats = ["train", "val"]
+                .map(|split| {
+                    dir.path()
+                        .join("ds")
+                        .join(split)
+                        .join("scene_0000/stats.json")
+                })
+                .into_iter()
+                .find(|p| p.exists())
+                .expect("the scene's stats.json");
+            let stats: serde_json::Value =
+                serde_json::from_slice(&std::fs::read(stats).unwrap()).unwrap();
+            let placed = stats["placement"]["from_catalog"].as_u64().unwrap();
+            assert!(placed > 0, "no catalogue piece placed");
+        } else {
+            assert!(err.contains("procedural furniture only"), "{err}");
+            assert_eq!(recorded, "");
+        }
+    }
+}

@@ -20,6 +20,9 @@ pub const MAX_EV: f64 = 10.0;
 pub const MAX_TEXTURES: u32 = 100_000;
 
 /// The built-in procedural scene generator.
+/// `catalog`'s default: the binary picks the Sweet Home 3D catalogue when it is installed.
+pub const AUTO_CATALOG: &str = "auto";
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct RoomSettings {
@@ -57,7 +60,8 @@ pub struct RoomSettings {
     /// of it emit 0.2–0.6 of it).
     pub window_light: [f64; 2],
     /// Asset catalogue (`catalog.json`) to draw pieces from besides the procedural furniture;
-    /// empty: procedural only.
+    /// empty: procedural only. The binary resolves `"auto"` (its default) to the Sweet Home 3D
+    /// catalogue where `lfgen assets fetch sweethome3d` writes it, or to empty.
     pub catalog: String,
     /// With a catalogue: the share of pieces drawn from it (the rest are procedural).
     pub catalog_share: f64,
@@ -147,7 +151,7 @@ impl Default for RoomSettings {
             windows: [0, 2],
             door: 0.35,
             window_light: [2.0, 6.0],
-            catalog: String::new(),
+            catalog: AUTO_CATALOG.into(),
             catalog_share: 0.5,
             category_weights: std::collections::BTreeMap::new(),
             lighting: LightingWeights::default(),
