@@ -30,7 +30,7 @@ pub enum Role {
     Sheer,
     /// Woven or grid alpha cut-out (mesh backs, screens).
     Mesh,
-    /// Alpha-textured leaves.
+    /// A leaf silhouette cut out of a unit quad (one leaf per quad, scaled to its size).
     Leaf,
     Book,
     /// A picture: a textured print.
@@ -189,6 +189,18 @@ impl Builder<'_> {
         self.push(name, Shape::Cuboid { size }, xf, role);
     }
 
+    /// A soft cushion: a sphere flattened to `size`, given by the centre of its bottom.
+    fn cushion(&mut self, name: &'static str, size: Vec3, bottom: Vec3, role: Role) {
+        let shape = Shape::Sphere {
+            radius: 0.5,
+            rings: 12,
+            segments: 24,
+        };
+        let mut xf = Transform::at(bottom + Vec3::Y * size.y / 2.0);
+        xf.scale = size;
+        self.push(name, shape, xf, role);
+    }
+
     fn cylinder(&mut self, name: &'static str, r: f32, h: f32, bottom: Vec3, role: Role) {
         let shape = Shape::Cylinder {
             radius: r,
@@ -212,6 +224,21 @@ impl Builder<'_> {
     fn panel(&mut self, name: &'static str, size: [f32; 2], centre: Vec3, yaw: f32, role: Role) {
         let xf = Transform::at(centre).rotated_y(yaw);
         self.push(name, Shape::Quad { size }, xf, role);
+    }
+
+    /// A leaf: a unit quad (one period of the leaf silhouette, [`Role::Leaf`]) scaled to the
+    /// leaf's size, its base at the attachment point. Returns its corners.
+    fn leaf(&mut self, leaf: Leaf) -> [Vec3; 4] {
+        let rotation = Quat::from_rotation_y(leaf.yaw) * Quat::from_rotation_x(leaf.tilt);
+        let xf = Transform {
+            translation: leaf.base + rotation * Vec3::Y * (leaf.size.y / 2.0),
+            rotation,
+            scale: leaf.size.extend(1.0),
+        };
+        let corners = [[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]]
+            .map(|[u, v]| xf.matrix().transform_point3(Vec3::new(u, v, 0.0)));
+        self.push("leaf", Shape::Quad { size: [1.0, 1.0] }, xf, Role::Leaf);
+        corners
     }
 
     /// A surface at height `y` over the rectangle `centre ± half`.
@@ -692,10 +719,10 @@ fn bed(d: &mut Draw, b: &mut Builder) -> Extent {
     let pw = (w - 0.1) / pillows as f32;
     for k in 0..pillows {
         let x = -w / 2.0 + 0.05 + pw * (k as f32 + 0.5);
-        b.block(
+        b.cushion(
             "pillow",
-            Vec3::new(pw - 0.05, 0.1, 0.35),
-            Vec3::new(x, frame_h + 0.2, -l / 2.0 + 0.3),
+            Vec3::new(pw - 0.05, 0.12, 0.35),
+            Vec3::new(x, frame_h + 0.18, -l / 2.0 + 0.3),
             Role::Fabric,
         );
     }
@@ -752,7 +779,8 @@ fn lamp(d: &mut Draw, b: &mut Builder, h: [f32; 2]) -> Extent {
     (Vec2::splat(lo.max(r * 0.8)), h, 0.0)
 }
 
-/// A pot of revolution with a spray of alpha-textured leaf cards.
+/// A pot of revolution with a plant of single leaves, each its own tilted quad: a rosette
+/// fanning out of the soil (a dracaena, a snake plant) or a trunk carrying a crown (a ficus).
 fn plant(d: &mut Draw, b: &mut Builder) -> Extent {
     let (r, ph) = (d.range(0.12, 0.25), d.range(0.2, 0.45));
     let pot = match d.pick("pot", 3) {
@@ -779,21 +807,77 @@ fn plant(d: &mut Draw, b: &mut Builder) -> Extent {
         ],
     };
     b.lathe("pot", pot, Vec3::ZERO, Role::Ceramic);
+    let soil = ph * 0.9;
     let tall = d.range(0.4, 1.4);
-    let cards = 3 + d.pick("cards", 4);
-    for k in 0..cards {
-        let yaw = k as f32 * PI / cards as f32 + d.range(-0.2, 0.2);
-        let w = r * d.range(2.0, 3.5);
-        let h = tall * d.range(0.7, 1.0);
-        b.panel(
-            "leaves",
-            [w, h],
-            Vec3::Y * (ph * 0.8 + h / 2.0),
-            yaw,
-            Role::Leaf,
-        );
+    let mut reach = Reach {
+        half: Vec2::splat(r),
+        top: ph,
+    };
+    if d.pick("habit", 2) == 0 {
+        let count = 10 + d.pick("leaves", 3) * 6;
+        let length = tall * d.range(0.35, 0.6);
+        let width = d.range(0.2, 0.4);
+        for k in 0..count {
+            let l = length * d.range(0.6, 1.0);
+            let leaf = Leaf {
+                base: Vec3::Y * soil,
+                yaw: k as f32 * GOLDEN_ANGLE + d.range(-0.3, 0.3),
+                tilt: d.range(0.1, 1.1),
+                size: Vec2::new(l * width, l),
+            };
+            reach.add(b.leaf(leaf));
+        }
+    } else {
+        let trunk = soil + tall * 0.5;
+        b.cylinder("trunk", r * 0.08, trunk - soil, Vec3::Y * soil, Role::Wood);
+        let crown = tall * d.range(0.2, 0.35);
+        let count = 24 + d.pick("leaves", 3) * 12;
+        let length = d.range(0.08, 0.16);
+        for k in 0..count {
+            let yaw = k as f32 * GOLDEN_ANGLE;
+            let out = crown * d.range(0.0, 0.8);
+            let l = length * d.range(0.7, 1.0);
+            let leaf = Leaf {
+                base: Vec3::new(
+                    yaw.sin() * out,
+                    trunk + d.range(0.0, tall * 0.4),
+                    yaw.cos() * out,
+                ),
+                yaw: yaw + d.range(-0.5, 0.5),
+                tilt: d.range(0.6, 1.9),
+                size: Vec2::new(l * d.range(0.35, 0.5), l),
+            };
+            reach.add(b.leaf(leaf));
+        }
     }
-    (Vec2::splat(r.max(r * 1.75)), ph + tall, 0.0)
+    (reach.half, reach.top, 0.0)
+}
+
+/// The angle between successive leaves of a spiral (phyllotaxis): no two line up.
+const GOLDEN_ANGLE: f32 = 2.399_963;
+
+/// One leaf: attached at `base`, turned `yaw` about the vertical and tilted `tilt` from it
+/// (radians; past π/2 it hangs), `size` its width and length.
+struct Leaf {
+    base: Vec3,
+    yaw: f32,
+    tilt: f32,
+    size: Vec2,
+}
+
+/// The footprint half extents and the height a piece's parts reach so far.
+struct Reach {
+    half: Vec2,
+    top: f32,
+}
+
+impl Reach {
+    fn add(&mut self, corners: [Vec3; 4]) {
+        for c in corners {
+            self.half = self.half.max(Vec2::new(c.x.abs(), c.z.abs()));
+            self.top = self.top.max(c.y);
+        }
+    }
 }
 
 /// A folding room screen: hinged leaves with a woven or grid alpha pattern in a frame.
@@ -1185,6 +1269,45 @@ mod tests {
         assert!(Kind::ALL.len() >= 20);
         println!("{} kinds, {total} distinct variants", Kind::ALL.len());
         assert!(total >= 750, "{total} variants");
+    }
+
+    /// A plant is single leaves, not cards: at least ten unit quads scaled to leaf size
+    /// (one silhouette each), fanned out around the stem at many tilts, each attached at the
+    /// soil or on the trunk, inside the pot's rim or the crown.
+    #[test]
+    fn plants_are_single_tilted_leaves() {
+        for i in 0..40 {
+            let p = build(Kind::Plant, &mut Pcg32::new(i, 5), &mut Count(0));
+            let leaves: Vec<&Part> = p.parts.iter().filter(|q| q.name == "leaf").collect();
+            assert!(leaves.len() >= 10, "#{i}: {} leaves", leaves.len());
+            let mut axes: Vec<Vec3> = Vec::new();
+            for leaf in &leaves {
+                assert_eq!(leaf.shape, Shape::Quad { size: [1.0, 1.0] });
+                let s = leaf.transform.scale;
+                assert!(s.x > 0.01 && s.y > s.x && s.y < 1.0, "#{i}: leaf {s}");
+                axes.push(leaf.transform.rotation * Vec3::Y);
+                let m = leaf.transform.matrix();
+                let base = m.transform_point3(Vec3::new(0.0, -0.5, 0.0));
+                assert!(
+                    base.y > 0.1 && Vec2::new(base.x, base.z).length() < 0.6,
+                    "#{i}: {base}"
+                );
+            }
+            // They fan out around the stem (their horizontal directions cancel) at many tilts.
+            let n = axes.len() as f32;
+            let fan = axes
+                .iter()
+                .map(|a| Vec2::new(a.x, a.z))
+                .sum::<Vec2>()
+                .length()
+                / n;
+            let mean_up = axes.iter().map(|a| a.y).sum::<f32>() / n;
+            let spread = (axes.iter().map(|a| (a.y - mean_up).powi(2)).sum::<f32>() / n).sqrt();
+            assert!(
+                fan < 0.35 && spread > 0.05,
+                "#{i}: fan {fan}, tilt spread {spread}"
+            );
+        }
     }
 
     /// Every part lies within the reported footprint (plus a small tolerance) and height.

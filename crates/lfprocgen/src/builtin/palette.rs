@@ -191,11 +191,11 @@ impl Gen<'_> {
         self.push_material(m)
     }
 
-    /// Leaves: green-ish, alpha-textured leaf silhouettes.
+    /// Leaves: green-ish, one leaf silhouette per unit of UV (a unit quad is one leaf).
     fn leaf(&mut self, name: &str) -> u32 {
         let g = 0.15 + 0.35 * self.unit();
         let c = [g * self.between(0.3, 0.7), g, g * self.between(0.1, 0.4)];
-        let period = [self.between(0.05, 0.12), self.between(0.12, 0.3)];
+        let period = [1.0, 1.0];
         let m = self.standard(name, Texture::constant(c), 0.5, Opacity::Leaves { period });
         self.push_material(m)
     }
