@@ -14,7 +14,7 @@ use crate::scene::{Shape, Transform};
 use glam::{Quat, Vec2, Vec3};
 use rand::RngExt;
 use rand_pcg::Pcg32;
-use std::f32::consts::{FRAC_PI_2, PI};
+use std::f32::consts::FRAC_PI_2;
 
 /// What a part is made of; the scene generator turns each role into a material (and may make
 /// it semi-transparent or glass).
