@@ -12,10 +12,10 @@ use crate::bins::Bins;
 use crate::lightfield::LightField;
 use crate::stacks::{Direction, Region, shift_view};
 
-/// Variance floor before the logarithm of [`cost_stack`]: about the variance of 8-bit
-/// quantisation noise summed over RGB, so that exact matches on flat colour do not dominate
-/// the input's range.
-const VARIANCE_FLOOR: f32 = 1e-5;
+/// The default variance floor before the logarithm of [`cost_stack`]: about the variance of
+/// 8-bit quantisation noise summed over RGB, so that exact matches on flat colour do not
+/// dominate the input's range.
+pub const VARIANCE_FLOOR: f32 = 1e-5;
 
 /// One cost slice per bin centre over every loaded view of `lf`, each `width × height`
 /// row-major: `[k][y * width + x]`.
@@ -42,7 +42,8 @@ pub fn cost_slice(lf: &LightField, d: f32) -> Vec<f32> {
 /// planes of `region.width × region.height`), for the light field EPI-shifted by `shift`.
 ///
 /// Each plane is `ln(var + floor)` of the views' colours at that hypothesis (RGB variances
-/// summed), centred per pixel over the hypotheses: the logarithm makes a contrast change an
+/// summed; `floor` the cost of a perfect match, e.g. [`VARIANCE_FLOOR`]), centred per pixel
+/// over the hypotheses: the logarithm makes a contrast change an
 /// offset, and the centring removes it, so the network sees where along the hypotheses the
 /// views agree, not how textured the pixel is in absolute terms.
 pub fn cost_stack(
@@ -51,6 +52,7 @@ pub fn cost_stack(
     region: Region,
     shift: f32,
     hypotheses: &[f32],
+    floor: f32,
 ) -> Vec<f32> {
     let plane = region.width * region.height;
     let positions = dir.positions(lf.nx);
@@ -60,7 +62,7 @@ pub fn cost_stack(
         variance(lf, &positions, region, shift + h, &mut scratch, slice);
         slice
             .iter_mut()
-            .for_each(|v| *v = (v.max(0.0) + VARIANCE_FLOOR).ln());
+            .for_each(|v| *v = (v.max(0.0) + floor).ln());
     }
     centre_per_pixel(&mut out, plane);
     out
@@ -239,9 +241,12 @@ mod tests {
         };
         let dir = Direction::Diagonal45;
         let hyps = [-1.0, -0.5, 0.0, 0.5];
-        let base = cost_stack(&lf, dir, region, 0.5, &hyps);
+        let base = cost_stack(&lf, dir, region, 0.5, &hyps, VARIANCE_FLOOR);
         let moved: Vec<f32> = hyps.iter().map(|h| h + 0.5).collect();
-        assert_eq!(cost_stack(&lf, dir, region, 0.0, &moved), base);
+        assert_eq!(
+            cost_stack(&lf, dir, region, 0.0, &moved, VARIANCE_FLOOR),
+            base
+        );
         // Doubling the contrast about 0.5 quadruples every variance: after the logarithm
         // and the centring only the floor's share changes, which matters only where the
         // views agree to within the floor. The best hypothesis of every pixel stays.
@@ -249,7 +254,7 @@ mod tests {
         for view in contrast.views.iter_mut().flatten() {
             view.iter_mut().for_each(|x| *x = 0.5 + 2.0 * (*x - 0.5));
         }
-        let doubled = cost_stack(&contrast, dir, region, 0.5, &hyps);
+        let doubled = cost_stack(&contrast, dir, region, 0.5, &hyps, VARIANCE_FLOOR);
         let plane = 16 * 16;
         let best = |c: &[f32], i: usize| {
             (0..hyps.len())
@@ -281,7 +286,7 @@ mod tests {
             height: 16,
         };
         for dir in Direction::ALL {
-            let cost = cost_stack(&lf, dir, region, 0.0, &hyps);
+            let cost = cost_stack(&lf, dir, region, 0.0, &hyps, VARIANCE_FLOOR);
             let plane = 16 * 16;
             for i in [0, 37, 255] {
                 let best = (0..hyps.len())
@@ -294,10 +299,56 @@ mod tests {
             }
             // At the true disparity the views agree to interpolation error only.
             let k = hyps.iter().position(|&h| h == d).unwrap();
-            let raw = cost_stack(&lf, dir, region, 0.0, &[d]);
+            let raw = cost_stack(&lf, dir, region, 0.0, &[d], VARIANCE_FLOOR);
             assert_eq!(raw.iter().copied().fold(0.0, f32::max), 0.0);
             let _ = k;
         }
+    }
+
+    /// Sensor noise of σ = 2/255 lifts the cost of a perfect match from 8-bit quantisation to
+    /// about `3σ²`: with the default floor the input's dips change by logs, with a floor at
+    /// a camera's noise variance they hardly move, and the best hypothesis stays.
+    #[test]
+    fn a_floor_at_the_noise_variance_hides_the_noise() {
+        let lf = plane_at(1.0, 40);
+        let mut noisy = lf.clone();
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let sigma = 2.0 / 255.0;
+        for v in noisy
+            .views
+            .iter_mut()
+            .flatten()
+            .flat_map(|view| view.iter_mut())
+        {
+            // Uniform on ±σ√3 (variance σ²) from a xorshift stream.
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let u = (state >> 11) as f32 / (1u64 << 53) as f32;
+            *v += sigma * 3f32.sqrt() * (2.0 * u - 1.0);
+        }
+        let region = Region {
+            x0: 12,
+            y0: 12,
+            width: 16,
+            height: 16,
+        };
+        let hyps: Vec<f32> = (-4..=4).map(|k| k as f32 * 0.5).collect();
+        let gap = |floor: f32| {
+            let (dir, plane) = (Direction::Horizontal, 16 * 16);
+            let clean = cost_stack(&lf, dir, region, 0.0, &hyps, floor);
+            let rough = cost_stack(&noisy, dir, region, 0.0, &hyps, floor);
+            let best = |c: &[f32], i: usize| {
+                (0..hyps.len())
+                    .min_by(|&a, &b| c[a * plane + i].total_cmp(&c[b * plane + i]))
+                    .unwrap()
+            };
+            assert!((0..plane).all(|i| best(&clean, i) == best(&rough, i)));
+            let sum: f32 = clean.iter().zip(&rough).map(|(a, b)| (a - b).abs()).sum();
+            sum / clean.len() as f32
+        };
+        let (default, camera) = (gap(VARIANCE_FLOOR), gap(3.0 * (3.0f32 / 255.0).powi(2)));
+        assert!(camera < default / 3.0, "{camera} vs {default}");
     }
 
     #[test]

@@ -1,9 +1,11 @@
 //! Photometric augmentations of the thesis (§5.3.1): a rotation of the colours in RGB space and
 //! random brightness and contrast; and, not in the thesis, the degradations of a real camera
-//! ([`Degrade`]: blur and sensor noise), so that a net trained on clean rendered views keeps
+//! ([`Degrade`]: blur, vignetting, sensor noise and JPEG), so that a net trained on clean rendered views keeps
 //! working on noisy captured ones. The geometric augmentations (EPI shift, 90° rotation,
 //! down-scaling) live with the geometry in [`lfdata::stacks`] and [`lfdata::lightfield`].
 
+use image::RgbImage;
+use lfdata::camera::{Vignette, jpeg_round_trip};
 use rand::{Rng, RngExt};
 use rand_distr::{Distribution, StandardNormal};
 use rand_pcg::Pcg32;
@@ -45,14 +47,10 @@ impl Photometric {
             }
             ColourAugment::Off => Self::IDENTITY.matrix,
         };
-        let mut within = |[lo, hi]: [f32; 2]| {
-            if lo < hi {
-                rng.random_range(lo..=hi)
-            } else {
-                lo
-            }
-        };
-        let (gain, stretch) = (within(cfg.brightness_scale), within(cfg.contrast_scale));
+        let (gain, stretch) = (
+            within(rng, cfg.brightness_scale),
+            within(rng, cfg.contrast_scale),
+        );
         Self {
             matrix,
             gain,
@@ -109,6 +107,10 @@ pub struct Degrade {
     pub shot: f32,
     /// Gaussian blur σ, pixels (0: none).
     pub blur: f32,
+    /// Share of light lost at the scene's corners (0: none).
+    pub vignetting: f32,
+    /// JPEG quality (0: not compressed).
+    pub jpeg: u8,
     /// Seeds the noise streams (one per view).
     pub seed: u64,
 }
@@ -119,46 +121,58 @@ impl Degrade {
         noise: 0.0,
         shot: 0.0,
         blur: 0.0,
+        vignetting: 0.0,
+        jpeg: 0,
         seed: 0,
     };
 
-    /// A random draw under `cfg`; draws nothing from `rng` when both degradations are off, so
-    /// configurations without them train exactly as before they existed.
+    /// A random draw under `cfg`; draws nothing from `rng` when every degradation is off, and
+    /// draws the later ones only when they are on, so configurations without them train
+    /// exactly as before they existed.
     pub fn random(cfg: &AugmentConfig, rng: &mut impl Rng) -> Self {
-        if cfg.noise[1] <= 0.0 && cfg.blur[1] <= 0.0 {
+        let camera = cfg.vignetting[1] > 0.0 || cfg.jpeg_share > 0.0;
+        if cfg.noise[1] <= 0.0 && cfg.blur[1] <= 0.0 && !camera {
             return Self::NONE;
         }
-        let mut within = |[lo, hi]: [f32; 2]| {
-            if lo < hi {
-                rng.random_range(lo..=hi)
-            } else {
-                lo
-            }
-        };
-        let (noise, blur) = (within(cfg.noise), within(cfg.blur));
-        Self {
+        let (noise, blur) = (within(rng, cfg.noise), within(rng, cfg.blur));
+        let mut draw = Self {
             noise,
             shot: cfg.noise_shot,
             blur,
             seed: rng.random(),
+            ..Self::NONE
+        };
+        if camera {
+            draw.vignetting = within(rng, cfg.vignetting);
+            let [lo, hi] = cfg.jpeg_quality;
+            if rng.random_range(0.0f32..1.0) < cfg.jpeg_share {
+                draw.jpeg = rng.random_range(lo..=hi);
+            }
         }
+        draw
     }
 
     /// [`Degrade::apply`] to every view present of a light field's `views` (RGB interleaved,
-    /// `width` pixels a row), each with its index as its noise stream.
-    pub fn apply_all(&self, views: &mut [Option<Vec<f32>>], width: usize) {
+    /// `width` pixels a row), each with its index as its noise stream; `lens` places the
+    /// vignetting's falloff on the crop.
+    pub fn apply_all(&self, views: &mut [Option<Vec<f32>>], width: usize, lens: Vignette) {
+        let lens = (self.vignetting > 0.0).then_some(lens);
         for (index, view) in views.iter_mut().enumerate() {
             if let Some(rgb) = view {
-                self.apply(rgb, width, index);
+                self.apply(rgb, width, index, lens.as_ref());
             }
         }
     }
 
-    /// Blurs, then adds noise to, view number `index` of a sample: `rgb` interleaved,
-    /// `width` pixels a row.
-    pub fn apply(&self, rgb: &mut [f32], width: usize, index: usize) {
+    /// Blurs, vignettes, adds noise to and compresses view number `index` of a sample: `rgb`
+    /// interleaved sRGB values, `width` pixels a row; in a camera's order (lens, sensor,
+    /// encoder).
+    pub fn apply(&self, rgb: &mut [f32], width: usize, index: usize, lens: Option<&Vignette>) {
         if self.blur > 0.0 {
             gaussian_blur(rgb, width, self.blur);
+        }
+        if let Some(lens) = lens {
+            vignette(rgb, width, lens);
         }
         if self.noise > 0.0 {
             let mut rng = Pcg32::new(self.seed, index as u64);
@@ -169,7 +183,44 @@ impl Degrade {
                 *v += self.noise * variance.sqrt() * z;
             }
         }
+        if self.jpeg > 0 {
+            jpeg(rgb, width, self.jpeg);
+        }
     }
+}
+
+/// A uniform draw from `[lo, hi]`; `lo` without drawing when the range is empty.
+fn within(rng: &mut impl Rng, [lo, hi]: [f32; 2]) -> f32 {
+    if lo < hi {
+        rng.random_range(lo..=hi)
+    } else {
+        lo
+    }
+}
+
+/// Divides the linear light of `rgb` (sRGB values, `width` pixels a row) by `lens`' falloff.
+fn vignette(rgb: &mut [f32], width: usize, lens: &Vignette) {
+    use lfformat::srgb::{from_linear, to_linear};
+    for (i, px) in rgb.chunks_exact_mut(3).enumerate() {
+        let s2 = lens.falloff(i % width, i / width);
+        px.iter_mut()
+            .for_each(|v| *v = from_linear(to_linear(*v) / s2));
+    }
+}
+
+/// `rgb` (sRGB values in `[0, 1]`, `width` pixels a row) as 8-bit pixels through a JPEG
+/// encoder at `quality` and back.
+fn jpeg(rgb: &mut [f32], width: usize, quality: u8) {
+    let height = rgb.len() / (3 * width);
+    let bytes = rgb
+        .iter()
+        .map(|v| (v * 255.0).round().clamp(0.0, 255.0) as u8);
+    let img = RgbImage::from_raw(width as u32, height as u32, bytes.collect())
+        .expect("a view holds width × height RGB pixels");
+    let out = jpeg_round_trip(&img, quality).expect("an in-memory RGB image encodes as JPEG");
+    rgb.iter_mut()
+        .zip(out.as_raw())
+        .for_each(|(v, &b)| *v = b as f32 / 255.0);
 }
 
 /// Separable Gaussian blur of standard deviation `sigma` pixels over an RGB-interleaved image
@@ -301,7 +352,7 @@ mod tests {
         };
         let stats = |value: f32, index: usize| {
             let mut v = vec![value; 3 * 128 * 128];
-            d.apply(&mut v, 128, index);
+            d.apply(&mut v, 128, index, None);
             let n = v.len() as f64;
             let mean = v.iter().map(|&x| x as f64).sum::<f64>() / n;
             let var = v.iter().map(|&x| (x as f64 - mean).powi(2)).sum::<f64>() / n;
@@ -366,6 +417,55 @@ mod tests {
             Degrade::NONE
         );
         assert_eq!(a.random::<u64>(), b.random::<u64>());
+        let camera = AugmentConfig {
+            vignetting: [0.2, 0.6],
+            jpeg_share: 0.5,
+            jpeg_quality: [30, 60],
+            ..AugmentConfig::default()
+        };
+        let draws: Vec<Degrade> = (0..400)
+            .map(|_| Degrade::random(&camera, &mut rng))
+            .collect();
+        assert!(draws.iter().all(|d| (0.2..=0.6).contains(&d.vignetting)));
+        assert!(
+            draws
+                .iter()
+                .all(|d| d.jpeg == 0 || (30..=60).contains(&d.jpeg))
+        );
+        let compressed = draws.iter().filter(|d| d.jpeg > 0).count();
+        assert!((160..240).contains(&compressed), "{compressed} of 400");
+    }
+
+    /// Vignetting takes the drawn share of linear light at the scene's corners and none at
+    /// its centre, the same in every view; JPEG gives the benchmark's 8-bit round trip.
+    #[test]
+    fn vignetting_and_jpeg_are_the_benchmark_s() {
+        let (w, h) = (40, 30);
+        let d = Degrade {
+            vignetting: 0.5,
+            ..Degrade::NONE
+        };
+        let mut views = vec![Some(vec![1.0f32; 3 * w * h]); 3];
+        d.apply_all(&mut views, w, Vignette::centred(0.5, (w, h)));
+        let linear = |v: &[f32], x: usize, y: usize| lfformat::srgb::to_linear(v[3 * (y * w + x)]);
+        for view in views.iter().flatten() {
+            assert_eq!(view, views[0].as_ref().unwrap());
+            assert!((linear(view, 0, 0) - 0.5).abs() < 0.02);
+            assert!((linear(view, w - 1, h - 1) - 0.5).abs() < 0.02);
+            assert!(linear(view, w / 2, h / 2) > 0.99);
+        }
+        let texture: Vec<u8> = (0..3 * w * h).map(|i| ((i * 37) % 251) as u8).collect();
+        let mut rgb: Vec<f32> = texture.iter().map(|&b| b as f32 / 255.0).collect();
+        let d = Degrade {
+            jpeg: 30,
+            ..Degrade::NONE
+        };
+        d.apply(&mut rgb, w, 0, None);
+        let img = RgbImage::from_raw(w as u32, h as u32, texture).unwrap();
+        let want = jpeg_round_trip(&img, 30).unwrap();
+        let got: Vec<u8> = rgb.iter().map(|v| (v * 255.0).round() as u8).collect();
+        assert_eq!(&got, want.as_raw());
+        assert_ne!(&got, img.as_raw());
     }
 
     #[test]

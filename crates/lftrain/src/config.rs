@@ -97,6 +97,12 @@ pub struct NetConfig {
     pub cost_width: usize,
     /// Blocks of the per-hypothesis net (its receptive radius is `cost_blocks + 1`).
     pub cost_blocks: usize,
+    /// The cost of a perfect match: the variance added before the cost's logarithm
+    /// ([`lfdata::cost::cost_stack`]; RGB variances summed). The default, 8-bit quantisation,
+    /// lets clean rendered views match far more exactly than a camera's noise allows, and a
+    /// net trained on such dips loses them under noise; a floor near a camera's `3σ²` makes
+    /// clean and noisy matches look alike.
+    pub cost_floor: f32,
 }
 
 /// The network that reads cost volumes ([`NetInput::Cost`]).
@@ -148,6 +154,7 @@ impl Default for NetConfig {
             cost_network: CostNetwork::Streams,
             cost_width: 8,
             cost_blocks: 5,
+            cost_floor: lfdata::cost::VARIANCE_FLOOR,
         }
     }
 }
@@ -185,6 +192,15 @@ pub struct AugmentConfig {
     /// Optical blur (not in the thesis): a Gaussian σ in pixels per sample, drawn from this
     /// range, the same for every view, applied before the noise. `[0, 0]`: off.
     pub blur: [f32; 2],
+    /// Vignetting (not in the thesis): the share of light a scene's corners lose, per sample
+    /// from this range, by the cos⁴ law in linear light centred on the scene (each crop gets
+    /// its part of the falloff), the same in every view, before the noise. `[0, 0]`: off.
+    pub vignetting: [f32; 2],
+    /// JPEG compression (not in the thesis): the share of samples whose views are each
+    /// compressed, after the noise, ...
+    pub jpeg_share: f32,
+    /// ... at a quality (1–100) drawn per sample from this range.
+    pub jpeg_quality: [u8; 2],
 }
 
 /// The random colour matrix of a sample.
@@ -214,6 +230,9 @@ impl Default for AugmentConfig {
             noise: [0.0, 0.0],
             noise_shot: 0.5,
             blur: [0.0, 0.0],
+            vignetting: [0.0, 0.0],
+            jpeg_share: 0.0,
+            jpeg_quality: [30, 90],
         }
     }
 }
@@ -705,6 +724,9 @@ impl TrainConfig {
         if self.net.cost_width == 0 || self.net.cost_blocks == 0 {
             bail!("net.cost_width and net.cost_blocks must be ≥ 1");
         }
+        if !(self.net.cost_floor > 0.0 && self.net.cost_floor.is_finite()) {
+            bail!("net.cost_floor must be a finite variance > 0");
+        }
         if self.net.input == NetInput::Cost && self.model == ModelKind::EpiShift {
             bail!("net.input = \"cost\" is for BASE, UPR, ESE and DPP; EPI-Shift reads views");
         }
@@ -781,6 +803,17 @@ impl TrainConfig {
             bail!(
                 "augment.noise must be a [min, max] range within [0, 1], augment.blur one \
                  within [0, 16] px, and augment.noise_shot lie in [0, 1]"
+            );
+        }
+        let [v_lo, v_hi] = a.vignetting;
+        if !(0.0 <= v_lo && v_lo <= v_hi && v_hi < 1.0) {
+            bail!("augment.vignetting must be a [min, max] range of shares within [0, 1)");
+        }
+        let [q_lo, q_hi] = a.jpeg_quality;
+        if !((0.0..=1.0).contains(&a.jpeg_share) && 1 <= q_lo && q_lo <= q_hi && q_hi <= 100) {
+            bail!(
+                "augment.jpeg_share must lie in [0, 1] and augment.jpeg_quality be a \
+                 [min, max] range of qualities within [1, 100]"
             );
         }
         if !(0.0..1.0).contains(&self.texture_threshold) || self.texture_window.is_multiple_of(2) {

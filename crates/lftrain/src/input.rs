@@ -12,8 +12,9 @@ use crate::config::{NetInput, TrainConfig};
 pub enum StackInput {
     /// The stack's `n × 3` view planes.
     Views,
-    /// One cost plane per hypothesis, at these disparities (pixels).
-    Cost(Vec<f32>),
+    /// One cost plane per hypothesis, at these disparities (pixels), with this variance
+    /// floor ([`crate::config::NetConfig::cost_floor`]).
+    Cost(Vec<f32>, f32),
 }
 
 impl StackInput {
@@ -21,7 +22,7 @@ impl StackInput {
     pub fn of(cfg: &TrainConfig) -> Self {
         match cfg.net.input {
             NetInput::Views => StackInput::Views,
-            NetInput::Cost => StackInput::Cost(hypotheses(cfg)),
+            NetInput::Cost => StackInput::Cost(hypotheses(cfg), cfg.net.cost_floor),
         }
     }
 
@@ -29,7 +30,7 @@ impl StackInput {
     pub fn channels(&self, n: usize) -> usize {
         match self {
             StackInput::Views => n * 3,
-            StackInput::Cost(h) => h.len(),
+            StackInput::Cost(h, _) => h.len(),
         }
     }
 
@@ -37,7 +38,7 @@ impl StackInput {
     pub fn reach(&self) -> f32 {
         match self {
             StackInput::Views => 0.0,
-            StackInput::Cost(h) => h.iter().fold(0.0, |m, d| m.max(d.abs())),
+            StackInput::Cost(h, _) => h.iter().fold(0.0, |m, d| m.max(d.abs())),
         }
     }
 
@@ -45,7 +46,7 @@ impl StackInput {
     pub fn planes(&self, lf: &LightField, dir: Direction, region: Region, shift: f32) -> Vec<f32> {
         match self {
             StackInput::Views => extract(lf, dir, region, shift),
-            StackInput::Cost(h) => cost_stack(lf, dir, region, shift, h),
+            StackInput::Cost(h, floor) => cost_stack(lf, dir, region, shift, h, *floor),
         }
     }
 }

@@ -164,7 +164,7 @@ impl StackNet for EpiNet {
 /// soft argmin: differentiable, and finer than the hypotheses' spacing), UPR's and ESE's
 /// `log b` is channel `K`, and DPP's logits are the `K` channels themselves.
 pub fn decode(raw: Tensor<4>, model: ModelKind, input: &StackInput) -> Tensor<4> {
-    let StackInput::Cost(hypotheses) = input else {
+    let StackInput::Cost(hypotheses, _) = input else {
         return raw;
     };
     if model == ModelKind::Dpp {

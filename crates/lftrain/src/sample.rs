@@ -1,6 +1,7 @@
 //! Training samples: a random crop of a scene, rotated, EPI-shifted and colour-augmented, as
 //! the four stacks and the shifted targets; and batches of them in the network's layout.
 
+use lfdata::camera::Vignette;
 use lfdata::lightfield::{crop_plane, rotate_plane};
 use lfdata::stacks::{Direction, Region};
 use rand::{Rng, RngExt};
@@ -68,6 +69,14 @@ impl Draw {
             degrade: Degrade::random(cfg, rng),
         }
     }
+
+    /// The vignetting of a lens centred on a `scene`-sized image as the draw's crop sees it:
+    /// `side²` pixels from `corner`, every `scale`-th, turned by the draw's turns.
+    pub fn lens(&self, scene: (usize, usize), corner: (isize, isize), side: usize) -> Vignette {
+        Vignette::centred(self.degrade.vignetting, scene)
+            .in_crop(corner, self.scale.max(1))
+            .rotated(side, self.turns)
+    }
 }
 
 /// One sample: stacks in [`Direction::ALL`] order, each `n * 3` planes of `patch²`, and the
@@ -104,9 +113,8 @@ pub fn make_sample(
     let (x0, y0) = (draw.origin.0 as isize, draw.origin.1 as isize);
     let (m, k) = (margin as isize, draw.scale.max(1));
     let side = patch + 2 * margin;
-    let mut lf = (scene.lf)
-        .crop((x0 - m * k as isize, y0 - m * k as isize), (side, side), k)
-        .rotate(draw.turns);
+    let corner = (x0 - m * k as isize, y0 - m * k as isize);
+    let mut lf = scene.lf.crop(corner, (side, side), k).rotate(draw.turns);
     let region = Region {
         x0: margin,
         y0: margin,
@@ -131,7 +139,8 @@ pub fn make_sample(
         draw.photometric.apply(view, 1, pivot);
     }
     // After the colours, as a camera's noise comes after the scene's light.
-    draw.degrade.apply_all(&mut lf.views, lf.width);
+    let lens = draw.lens((scene.lf.width, scene.lf.height), corner, side);
+    draw.degrade.apply_all(&mut lf.views, lf.width, lens);
     let stacks = Direction::ALL.map(|dir| input.planes(&lf, dir, region, draw.shift));
     let (disparity, mut eta) = target_planes(&scene.targets, (x0, y0), patch, draw);
     let region = loss_region(scene, (x0, y0), patch, draw, border);

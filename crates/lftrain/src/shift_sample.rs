@@ -52,7 +52,8 @@ pub fn make_shift_sample(
     let corner = (x0 - m * k as isize, y0 - m * k as isize);
     let mut lf = scene.lf.crop(corner, (side, side), k).rotate(draw.turns);
     // Before the colours here, which apply to the extracted stacks.
-    draw.degrade.apply_all(&mut lf.views, side);
+    let lens = draw.lens((scene.lf.width, scene.lf.height), corner, side);
+    draw.degrade.apply_all(&mut lf.views, side, lens);
     let inside = inside_scene(scene, corner, side, k, draw.turns);
     let region = Region {
         x0: margin,

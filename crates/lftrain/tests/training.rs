@@ -542,7 +542,7 @@ fn decode_takes_the_soft_argmin_of_the_hypotheses() {
     use lftrain::input::StackInput;
     use lftrain::model::decode;
     let dev = device();
-    let input = StackInput::Cost(vec![-1.0, 0.0, 2.0]);
+    let input = StackInput::Cost(vec![-1.0, 0.0, 2.0], lfdata::cost::VARIANCE_FLOOR);
     // Pixel 0: logits (0, 0, 0), weights ⅓ each: (−1 + 0 + 2) / 3 = ⅓. Pixel 1: logits
     // (0, ln 2, 0), weights (¼, ½, ¼): −¼ + 0 + ½ = ¼. Channel 3 is log b: 0.5 and −1.
     let l2 = 2f32.ln();
