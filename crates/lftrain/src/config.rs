@@ -963,7 +963,8 @@ mod tests {
 
     /// The cost recipe: the per-hypothesis net on 60 hypotheses over ±4.5 px, radius 4 px
     /// (the baseline's 9×9 window), no EPI shift (the targets must stay inside the
-    /// hypotheses), the field recipe's schedule scaled to 1 000 steps.
+    /// hypotheses), sensor-noise augmentation, the field recipe's schedule scaled to 1 000
+    /// steps.
     #[test]
     fn the_cost_recipe_reads_cost_volumes_and_refuses_epishift() {
         let cost: TrainConfig = toml::from_str(include_str!("../configs/cpu_cost.toml")).unwrap();
@@ -972,6 +973,11 @@ mod tests {
         assert_eq!(cost.net.cost_network, CostNetwork::PerHypothesis);
         assert_eq!((cost.dpp.bins, cost.dpp.min, cost.dpp.max), (60, -4.5, 4.5));
         assert_eq!(cost.augment.max_shift, 0.0);
+        assert_eq!(
+            cost.augment.noise,
+            [0.0, 0.03],
+            "chosen by the robustness benchmark"
+        );
         assert_eq!(cost.net.receptive_radius(), 4);
         assert_eq!(
             (
