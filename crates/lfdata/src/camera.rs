@@ -9,6 +9,7 @@ use std::io::Cursor;
 use anyhow::{Context, Result};
 use image::RgbImage;
 use image::codecs::jpeg::JpegEncoder;
+use lfformat::srgb::{from_linear, to_linear};
 
 /// A lens' vignetting: linear light divided by `(1 + t² ρ²)²`, the cos⁴ law, `ρ` the distance
 /// from the optical centre over the image's half-diagonal and `t² = (1 − f)^-1/2 − 1` so that
@@ -65,6 +66,12 @@ impl Vignette {
         );
         let s = 1.0 + self.t2 * (dx * dx + dy * dy) / self.half_diagonal2;
         s * s
+    }
+
+    /// The sRGB value `v` (in `[0, 1]`) after a [`falloff`](Self::falloff), which acts on
+    /// linear light.
+    pub fn darken(v: f32, falloff: f32) -> f32 {
+        from_linear(to_linear(v) / falloff)
     }
 }
 

@@ -43,9 +43,9 @@ pub fn cost_slice(lf: &LightField, d: f32) -> Vec<f32> {
 ///
 /// Each plane is `ln(var + floor)` of the views' colours at that hypothesis (RGB variances
 /// summed; `floor` the cost of a perfect match, e.g. [`VARIANCE_FLOOR`]), centred per pixel
-/// over the hypotheses: the logarithm makes a contrast change an
-/// offset, and the centring removes it, so the network sees where along the hypotheses the
-/// views agree, not how textured the pixel is in absolute terms.
+/// over the hypotheses: the logarithm makes a contrast change an offset, and the centring
+/// removes it, so the network sees where along the hypotheses the views agree, not how
+/// textured the pixel is in absolute terms.
 pub fn cost_stack(
     lf: &LightField,
     dir: Direction,

@@ -1,7 +1,7 @@
 //! Photometric augmentations of the thesis (§5.3.1): a rotation of the colours in RGB space and
 //! random brightness and contrast; and, not in the thesis, the degradations of a real camera
-//! ([`Degrade`]: blur, vignetting, sensor noise and JPEG), so that a net trained on clean rendered views keeps
-//! working on noisy captured ones. The geometric augmentations (EPI shift, 90° rotation,
+//! ([`Degrade`]: blur, vignetting, sensor noise and JPEG), so that a net trained on clean
+//! rendered views keeps working on noisy captured ones. The geometric augmentations (EPI shift, 90° rotation,
 //! down-scaling) live with the geometry in [`lfdata::stacks`] and [`lfdata::lightfield`].
 
 use image::RgbImage;
@@ -200,11 +200,10 @@ fn within(rng: &mut impl Rng, [lo, hi]: [f32; 2]) -> f32 {
 
 /// Divides the linear light of `rgb` (sRGB values, `width` pixels a row) by `lens`' falloff.
 fn vignette(rgb: &mut [f32], width: usize, lens: &Vignette) {
-    use lfformat::srgb::{from_linear, to_linear};
     for (i, px) in rgb.chunks_exact_mut(3).enumerate() {
-        let s2 = lens.falloff(i % width, i / width);
+        let falloff = lens.falloff(i % width, i / width);
         px.iter_mut()
-            .for_each(|v| *v = from_linear(to_linear(*v) / s2));
+            .for_each(|v| *v = Vignette::darken(*v, falloff));
     }
 }
 

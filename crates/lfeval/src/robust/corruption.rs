@@ -116,9 +116,9 @@ fn map_values(img: &mut RgbImage, mut f: impl FnMut(f32) -> f32) {
 fn vignette(img: &mut RgbImage, lost: f32) {
     let lens = Vignette::centred(lost, (img.width() as usize, img.height() as usize));
     for (x, y, px) in img.enumerate_pixels_mut() {
-        let s2 = lens.falloff(x as usize, y as usize);
+        let falloff = lens.falloff(x as usize, y as usize);
         for v in px.0.iter_mut() {
-            let out = linear_to_srgb(srgb_to_linear(*v as f32 / 255.0) / s2);
+            let out = Vignette::darken(*v as f32 / 255.0, falloff);
             *v = (out * 255.0).round().clamp(0.0, 255.0) as u8;
         }
     }
