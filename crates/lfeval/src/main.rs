@@ -206,6 +206,10 @@ struct SlfcArgs {
     /// EPI window radius in pixels.
     #[arg(long, default_value_t = slfc::DEFAULT_RADIUS)]
     radius: usize,
+    /// Share of the centre view's profile variance the dictionary's generators (its
+    /// principal components) hold.
+    #[arg(long, default_value_t = slfc::DEFAULT_ENERGY, value_parser = fraction)]
+    energy: f64,
     /// Lasso stopping tolerance: duality gap relative to the window's squared norm.
     #[arg(long, default_value_t = slfc::DEFAULT_TOL)]
     tol: f64,
@@ -373,6 +377,7 @@ fn run_slfc(a: SlfcArgs, quiet: bool) -> Result<()> {
     let cfg = slfc::SlfcConfig {
         bins: a.bins.bins(&scenes)?,
         radius: a.radius,
+        energy: a.energy,
         lasso: slfc::lasso::LassoSettings {
             alpha: a.alpha,
             tol: a.tol,

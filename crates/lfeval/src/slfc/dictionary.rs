@@ -9,19 +9,25 @@
 //! longer than the window (the paper crops the shifted generator to the atom): they span
 //! `|t| ≤ R = r + ⌈max|s| · max|d|⌉`, every position any view of the window reaches.
 //!
-//! The paper takes the generators from dictionary learning or PCA of centre-view patches and
-//! reports 1-D generators as the best choice. Here they are the DCT-II basis of that support,
-//! `cos(πk(t + L/2)/L)` for `k = 1 ..= L − 1` (`L = 2R + 1`): the basis PCA of natural image
-//! rows approaches (their autocorrelation is close to stationary), complete on the support,
-//! so a surface's EPI window is exactly a combination of the atoms of its own disparity
-//! (a truncated or window-sized basis is not, and the Lasso then spreads the surface over
-//! neighbouring disparities). The generators are evaluated analytically at the sub-pixel
-//! positions `j + s·d`, so lifting needs no resampling and no training data. The constant
-//! generator (`k = 0`) is left out: a flat profile looks the same at every disparity.
+//! The paper lifts parts of the light field itself: 1-D generators learned from centre-view
+//! profiles (by dictionary learning or PCA), which it reports as the best of its choices.
+//! Here they are the principal components of the centre view's profiles of length
+//! `L = 2R + 1` along the stack's axis ([`Generators::of_view`]), as many as hold a given
+//! share of their variance. Each is stored as its coordinates in the DCT-II basis of the
+//! support, `cos(πk(t + L/2)/L)` for `k = 1 ..= L − 1`, which is orthogonal at the integer
+//! positions and gives the generator between them as a smooth interpolant, so lifting to a
+//! sub-pixel position `j + s·d` needs no resampling. The view's own components matter: with
+//! the whole DCT basis (complete, but far from sparse for a given texture) the Lasso codes a
+//! texture frequency that falls between two basis frequencies as a nearby basis frequency at
+//! a proportionally wrong disparity, up to 6 bins off per pixel at |d| > 2, where the
+//! components code a surface with few atoms of its own disparity (design/tried.md). The
+//! constant profile is left out: it looks the same at every disparity.
 //!
 //! Each atom has its mean removed (the Lasso fits an intercept: scikit-learn's default) and is
 //! scaled to unit root mean square, so its coefficient is an amplitude in intensity units and
 //! the authors' `α = 0.01` is one percent of the intensity range.
+
+use nalgebra::{DMatrix, SymmetricEigen};
 
 use super::lasso::Gram;
 
@@ -39,35 +45,40 @@ pub struct Dictionary {
 
 impl Dictionary {
     /// The dictionary for views at `offsets` (grid steps from the centre view along the EPI's
-    /// axis), windows of radius `radius` and one disparity per bin in `disparities`.
-    pub fn new(offsets: &[f32], radius: usize, disparities: &[f64]) -> Self {
+    /// axis), windows of radius `radius`, one disparity per bin in `disparities` and the
+    /// `generators` (whose support must be [`support`]`(offsets, radius, disparities)`).
+    pub fn new(
+        offsets: &[f32],
+        radius: usize,
+        disparities: &[f64],
+        generators: &Generators,
+    ) -> Self {
         let width = 2 * radius + 1;
         let len = offsets.len() * width;
-        let reach = offsets
-            .iter()
-            .fold(0.0f64, |m, &s| m.max(f64::from(s).abs()))
-            * disparities.iter().fold(0.0f64, |m, d| m.max(d.abs()));
-        let support = (2 * (radius + reach.ceil() as usize) + 1) as f64;
-        let generators = support as usize - 1;
-        let mut atoms = Vec::with_capacity(disparities.len() * generators * len);
+        let count = disparities.len() * generators.mixes.len();
+        let mut atoms = Vec::with_capacity(count * len);
+        let mut cosines = vec![0.0; len * generators.basis()];
         for &d in disparities {
-            for g in 0..generators {
-                let omega = std::f64::consts::PI * (g + 1) as f64 / support;
+            let positions = offsets.iter().flat_map(|&s| {
+                (0..width).map(move |j| j as f64 - radius as f64 + f64::from(s) * d)
+            });
+            for (t, row) in positions.zip(cosines.chunks_exact_mut(generators.basis())) {
+                generators.cosines(t, row);
+            }
+            for mix in &generators.mixes {
                 let start = atoms.len();
-                for &s in offsets {
-                    for j in 0..width {
-                        let t = j as f64 - radius as f64 + f64::from(s) * d;
-                        atoms.push((omega * (t + support / 2.0)).cos());
-                    }
-                }
+                atoms.extend(
+                    cosines
+                        .chunks_exact(generators.basis())
+                        .map(|row| row.iter().zip(mix).map(|(c, m)| c * m).sum::<f64>()),
+                );
                 normalise(&mut atoms[start..]);
             }
         }
-        let count = disparities.len() * generators;
         let gram = Gram::of(&atoms, count, len);
         Self {
             len,
-            generators,
+            generators: generators.mixes.len(),
             atoms,
             gram,
         }
@@ -86,6 +97,123 @@ impl Dictionary {
     }
 }
 
+/// The generators' support `L = 2R + 1`, `R = r + ⌈max|s| · max|d|⌉`: every position a view
+/// of a window of radius `radius` reaches at any of the `disparities`.
+pub fn support(offsets: &[f32], radius: usize, disparities: &[f64]) -> usize {
+    let reach = offsets
+        .iter()
+        .fold(0.0f64, |m, &s| m.max(f64::from(s).abs()))
+        * disparities.iter().fold(0.0f64, |m, d| m.max(d.abs()));
+    2 * (radius + reach.ceil() as usize) + 1
+}
+
+/// The 1-D generators of one stack, each as its coordinates in the DCT-II basis of the
+/// support (module doc).
+pub struct Generators {
+    /// Support length `L`.
+    pub support: usize,
+    /// One coordinate vector (`L − 1` values, `k = 1 ..= L − 1`) per generator.
+    pub mixes: Vec<Vec<f64>>,
+}
+
+impl Generators {
+    /// The principal components of `plane`'s profiles of length `support` along the stack's
+    /// axis (rows if `horizontal`), one centred on every pixel whose profile lies inside the
+    /// image (on every pixel, clamped at the border as the EPI windows are, when the image
+    /// is shorter than the support), their means removed: the fewest components that hold
+    /// `energy` of the profiles' variance, largest first, at least one.
+    pub fn of_view(
+        plane: &[f32],
+        (width, height): (usize, usize),
+        horizontal: bool,
+        support: usize,
+        energy: f64,
+    ) -> Self {
+        let basis = support - 1;
+        let dct = dct_matrix(support);
+        let mut cov = DMatrix::<f64>::zeros(basis, basis);
+        let (along, across) = if horizontal {
+            (width, height)
+        } else {
+            (height, width)
+        };
+        let half = support / 2;
+        let mut profile = vec![0.0f64; support];
+        let mut coords = nalgebra::DVector::<f64>::zeros(basis);
+        // Profiles that reach past the border repeat its pixel, a shape no surface has: they
+        // are left out unless the image is shorter than the support.
+        let centres = if along >= support {
+            half..along - half
+        } else {
+            0..along
+        };
+        for a in 0..across {
+            for c in centres.clone() {
+                for (i, p) in profile.iter_mut().enumerate() {
+                    let t = (c + i).saturating_sub(half).min(along - 1);
+                    *p = f64::from(
+                        plane[if horizontal {
+                            a * width + t
+                        } else {
+                            t * width + a
+                        }],
+                    );
+                }
+                for (k, o) in coords.iter_mut().enumerate() {
+                    *o = dct[k * support..(k + 1) * support]
+                        .iter()
+                        .zip(&profile)
+                        .map(|(b, p)| b * p)
+                        .sum();
+                }
+                cov.syger(1.0, &coords, &coords, 1.0);
+            }
+        }
+        cov.fill_upper_triangle_with_lower_triangle();
+        let eigen = SymmetricEigen::new(cov);
+        let mut order: Vec<usize> = (0..basis).collect();
+        order.sort_by(|&a, &b| eigen.eigenvalues[b].total_cmp(&eigen.eigenvalues[a]));
+        let total: f64 = eigen.eigenvalues.iter().map(|v| v.max(0.0)).sum();
+        let mut kept = 0.0;
+        let mut mixes = Vec::new();
+        for i in order {
+            if !mixes.is_empty() && kept >= energy * total {
+                break;
+            }
+            kept += eigen.eigenvalues[i].max(0.0);
+            mixes.push(eigen.eigenvectors.column(i).iter().copied().collect());
+        }
+        Self { support, mixes }
+    }
+
+    /// Number of DCT basis functions, `L − 1`.
+    fn basis(&self) -> usize {
+        self.support - 1
+    }
+
+    /// The basis functions at position `t` (`|t| ≤ R`), into `out`.
+    fn cosines(&self, t: f64, out: &mut [f64]) {
+        let l = self.support as f64;
+        for (k, o) in out.iter_mut().enumerate() {
+            *o = (std::f64::consts::PI * (k + 1) as f64 / l * (t + l / 2.0)).cos();
+        }
+    }
+}
+
+/// The orthonormal DCT-II basis functions `k = 1 ..= L − 1` at the integer positions
+/// `n = 0 .. L` (`t = n − R`), `(L − 1) × L` row-major: the coordinates of a profile.
+fn dct_matrix(support: usize) -> Vec<f64> {
+    let l = support as f64;
+    let scale = (2.0 / l).sqrt();
+    (1..support)
+        .flat_map(|k| {
+            (0..support).map(move |n| {
+                scale * (std::f64::consts::PI * k as f64 / l * (n as f64 + 0.5)).cos()
+            })
+        })
+        .collect()
+}
+
 /// Removes the mean of `v` and scales it to unit root mean square (a flat `v` stays zero).
 pub fn normalise(v: &mut [f64]) {
     let mean = v.iter().sum::<f64>() / v.len() as f64;
@@ -102,12 +230,27 @@ pub fn normalise(v: &mut [f64]) {
 mod tests {
     use super::*;
 
+    /// A `size²` grey view whose rows are `f(x, y)`.
+    fn view(size: usize, f: impl Fn(f64, f64) -> f64) -> Vec<f32> {
+        (0..size * size)
+            .map(|i| f((i % size) as f64, (i / size) as f64) as f32)
+            .collect()
+    }
+
     #[test]
     fn atoms_are_centred_unit_rms_and_shift_with_their_disparity() {
         let offsets = [-1.0f32, 0.0, 1.0];
-        let dict = Dictionary::new(&offsets, 2, &[0.0, 1.0]);
-        // Support radius 2 + ⌈1 · 1⌉ = 3: 7 samples, 6 generators.
-        assert_eq!((dict.len, dict.generators, dict.count()), (15, 6, 12));
+        // Support radius 2 + ⌈1 · 1⌉ = 3: 7 samples, 6 DCT functions.
+        let support = support(&offsets, 2, &[0.0, 1.0]);
+        assert_eq!(support, 7);
+        let plane = view(16, |x, y| {
+            ((x * 1.3 + y * y).sin() + (x * 0.4 - y).cos()) * 0.2
+        });
+        let generators = Generators::of_view(&plane, (16, 16), true, support, 1.0);
+        let g = generators.mixes.len();
+        assert!((1..=6).contains(&g), "{g} generators");
+        let dict = Dictionary::new(&offsets, 2, &[0.0, 1.0], &generators);
+        assert_eq!((dict.len, dict.generators, dict.count()), (15, g, 2 * g));
         for atom in dict.atoms.chunks_exact(dict.len) {
             let mean: f64 = atom.iter().sum::<f64>() / 15.0;
             let ms: f64 = atom.iter().map(|x| x * x).sum::<f64>() / 15.0;
@@ -118,7 +261,7 @@ mod tests {
         let at = |k: usize, g: usize, s: usize, j: usize| {
             dict.atoms[(k * dict.generators + g) * dict.len + s * 5 + j]
         };
-        for g in 0..6 {
+        for g in 0..g {
             for j in 0..5 {
                 assert!((at(0, g, 0, j) - at(0, g, 1, j)).abs() < 1e-12);
             }
@@ -128,5 +271,50 @@ mod tests {
         }
         // The Gram diagonal is each atom's squared norm: its length.
         assert!((dict.gram.values[0] - 15.0).abs() < 1e-9);
+    }
+
+    /// Rows of one wave at a phase that changes from row to row are two profiles (its sine and
+    /// cosine): PCA finds exactly two generators, and the DCT coordinates give the wave back
+    /// between the integer positions, where the lifted atoms sample it.
+    #[test]
+    fn a_single_wave_gives_two_generators_that_interpolate_it() {
+        let (size, support) = (48, 21);
+        let wave = |x: f64, y: f64| 0.5 + 0.2 * (0.9 * x + 0.37 * y).sin();
+        let plane = view(size, wave);
+        let generators = Generators::of_view(&plane, (size, size), true, support, 0.99);
+        assert_eq!(generators.mixes.len(), 2);
+        // Fit the row y = 30 around x = 24 at half-pixel positions with the two generators.
+        let half = (support / 2) as f64;
+        let positions: Vec<f64> = (0..2 * support - 1)
+            .map(|i| i as f64 / 2.0 - half)
+            .collect();
+        let mut row = vec![0.0; support - 1];
+        let columns: Vec<Vec<f64>> = generators
+            .mixes
+            .iter()
+            .map(|mix| {
+                positions
+                    .iter()
+                    .map(|&t| {
+                        generators.cosines(t, &mut row);
+                        row.iter().zip(mix).map(|(c, m)| c * m).sum()
+                    })
+                    .collect()
+            })
+            .collect();
+        let target: Vec<f64> = positions
+            .iter()
+            .map(|&t| wave(24.0 + t, 30.0) - 0.5)
+            .collect();
+        let a = DMatrix::from_fn(positions.len(), 2, |i, j| columns[j][i]);
+        let b = nalgebra::DVector::from_vec(target.clone());
+        let fit = a
+            .clone()
+            .svd(true, true)
+            .solve(&b, 1e-12)
+            .expect("least squares");
+        let residual = (a * fit - &b).norm() / b.norm();
+        // Away from the ends of the support the interpolant follows the wave closely.
+        assert!(residual < 0.02, "relative residual {residual}");
     }
 }

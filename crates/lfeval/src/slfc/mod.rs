@@ -17,7 +17,6 @@ pub mod dictionary;
 pub mod lasso;
 mod stack;
 
-use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Result, bail};
@@ -32,7 +31,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::report::errormap::luminance;
-use dictionary::Dictionary;
+use dictionary::{Dictionary, Generators};
 use lasso::LassoSettings;
 use stack::EpiStack;
 
@@ -43,6 +42,9 @@ pub struct SlfcConfig {
     pub bins: Bins,
     /// EPI window radius in pixels (windows of `2r + 1` columns over all views of a stack).
     pub radius: usize,
+    /// Share of the centre view's profile variance the generators hold
+    /// ([`dictionary::Generators::of_view`]).
+    pub energy: f64,
     /// The Lasso.
     pub lasso: LassoSettings,
     /// Side of the estimated centre crop, as a fraction of the image side (1: everything).
@@ -54,6 +56,7 @@ impl Default for SlfcConfig {
         Self {
             bins: Bins::THESIS,
             radius: DEFAULT_RADIUS,
+            energy: DEFAULT_ENERGY,
             lasso: LassoSettings {
                 alpha: DEFAULT_ALPHA,
                 tol: DEFAULT_TOL,
@@ -68,6 +71,9 @@ impl Default for SlfcConfig {
 pub const DEFAULT_ALPHA: f64 = 0.01;
 /// Window radius: 9-pixel windows, as wide as the 9 views of a stack are tall.
 pub const DEFAULT_RADIUS: usize = 4;
+/// Generators hold 99 % of the centre view's profile variance: on the analytic planes every
+/// pixel's strongest bin is then the plane's (±1), where 99.99 % lets one pixel in 64 stray.
+pub const DEFAULT_ENERGY: f64 = 0.99;
 /// scikit-learn's default duality-gap tolerance (relative to `‖y‖²`).
 pub const DEFAULT_TOL: f64 = 1e-4;
 /// scikit-learn's default iteration cap.
@@ -157,7 +163,7 @@ fn code_row(
 }
 
 /// The horizontal and vertical stacks of `lf` that have at least two views (one view shows
-/// no parallax), as grey images.
+/// no parallax), as grey images, each with the dictionary of its centre view's generators.
 fn stacks(lf: &LightField, cfg: &SlfcConfig) -> Result<Vec<EpiStack>> {
     let disparities = cfg.bins.centres();
     let mut out = Vec::new();
@@ -179,14 +185,22 @@ fn stacks(lf: &LightField, cfg: &SlfcConfig) -> Result<Vec<EpiStack>> {
             continue;
         }
         views.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let (offsets, planes): (Vec<f32>, _) = views.into_iter().unzip();
-        let dict = match out.iter().find(|s: &&EpiStack| s.offsets == offsets) {
-            Some(same) => Arc::clone(&same.dict),
-            None => Arc::new(Dictionary::new(&offsets, cfg.radius, &disparities)),
+        let (offsets, planes): (Vec<f32>, Vec<Vec<f32>>) = views.into_iter().unzip();
+        let Some(centre) = offsets.iter().position(|&s| s == 0.0) else {
+            bail!("SLFC learns its generators from the centre view, which is not loaded");
         };
+        let support = dictionary::support(&offsets, cfg.radius, &disparities);
+        let generators = Generators::of_view(
+            &planes[centre],
+            (lf.width, lf.height),
+            horizontal,
+            support,
+            cfg.energy,
+        );
+        let dict = Dictionary::new(&offsets, cfg.radius, &disparities, &generators);
         out.push(EpiStack::new(
             horizontal,
-            (offsets, planes),
+            planes,
             (lf.width, lf.height),
             cfg.radius,
             dict,

@@ -2,8 +2,6 @@
 //! view, the dictionary for their offsets, and the per-pixel Lasso coding of the EPI window
 //! around a pixel.
 
-use std::sync::Arc;
-
 use super::dictionary::Dictionary;
 use super::lasso::{self, LassoSettings, Problem, Workspace};
 
@@ -19,10 +17,8 @@ pub struct EpiStack {
     pub height: usize,
     /// Window radius.
     pub radius: usize,
-    /// View offsets along the axis, grid steps from the centre view.
-    pub offsets: Vec<f32>,
-    /// The atoms for these views (shared by stacks with the same offsets).
-    pub dict: Arc<Dictionary>,
+    /// The atoms for these views and this stack's generators.
+    pub dict: Dictionary,
 }
 
 /// Per-thread scratch of [`EpiStack::code`].
@@ -33,14 +29,14 @@ pub struct Scratch {
 }
 
 impl EpiStack {
-    /// The stack of `planes` at grid `offsets` along one axis, coding windows of radius
-    /// `radius` against `dict` (see [`Dictionary::new`]).
+    /// The stack of `planes` along one axis (in the order of the offsets `dict` was made
+    /// for), coding windows of radius `radius` against `dict` (see [`Dictionary::new`]).
     pub fn new(
         horizontal: bool,
-        (offsets, planes): (Vec<f32>, Vec<Vec<f32>>),
+        planes: Vec<Vec<f32>>,
         (width, height): (usize, usize),
         radius: usize,
-        dict: Arc<Dictionary>,
+        dict: Dictionary,
     ) -> Self {
         Self {
             horizontal,
@@ -48,7 +44,6 @@ impl EpiStack {
             width,
             height,
             radius,
-            offsets,
             dict,
         }
     }
