@@ -19,8 +19,9 @@
 //! sub-pixel position `j + s·d` needs no resampling. The view's own components matter: with
 //! the whole DCT basis (complete, but far from sparse for a given texture) the Lasso codes a
 //! texture frequency that falls between two basis frequencies as a nearby basis frequency at
-//! a proportionally wrong disparity, up to 6 bins off per pixel at |d| > 2, where the
-//! components code a surface with few atoms of its own disparity (design/tried.md). The
+//! a proportionally wrong disparity (at |d| > 2 only 2–40 of 64 pixels of an analytic plane
+//! within one bin), where the components code a surface with few atoms of its own
+//! disparity and put every pixel within one bin (design/tried.md). The
 //! constant profile is left out: it looks the same at every disparity.
 //!
 //! Each atom has its mean removed (the Lasso fits an intercept: scikit-learn's default) and is
