@@ -6,14 +6,17 @@
 use crate::config::{Config, ShadingMode};
 use crate::output::images::{ToneCurve, write_linear_exr, write_png};
 use crate::pipeline::{RenderJob, generate_scene};
+use crate::render::RenderScene;
+use crate::render::bsdf::{Frame, cosine_sample_hemisphere};
 use crate::render::framing::auto_exposure;
 use crate::render::integrator::Shading;
-use crate::render::sampler::RayKey;
+use crate::render::sampler::{RayKey, Sampler};
 use crate::render::view::{Adaptive, RenderSettings};
 use anyhow::{Context, Result};
 use glam::Vec3;
 use rayon::prelude::*;
 use serde_json::{Value, json};
+use std::hint::black_box;
 use std::path::Path;
 use std::sync::atomic::AtomicU64;
 use std::time::Instant;
@@ -41,53 +44,19 @@ pub fn speed(cfg: &Config) -> Result<Value> {
     let pixels: Vec<(u32, u32)> = (0..BENCH_RES)
         .flat_map(|y| (0..BENCH_RES).map(move |x| (x, y)))
         .collect();
-    let reps = 8;
-    let closest = time(|| {
-        pixels.par_iter().for_each(|&(x, y)| {
+    let camera: Vec<(Vec3, Vec3)> = pixels
+        .iter()
+        .map(|&(x, y)| {
             let r = rays.ray(x as f32 + 0.5, y as f32 + 0.5);
-            for k in 0..reps {
-                std::hint::black_box(scene.geometry.closest(
-                    &scene.materials,
-                    r.origin,
-                    r.dir,
-                    f32::INFINITY,
-                    RayKey {
-                        hash: k,
-                        phase: 0.0,
-                    },
-                ));
-            }
+            (r.origin, r.dir)
         })
-    });
-    let all = time(|| {
-        pixels.par_iter().for_each_init(Vec::new, |hits, &(x, y)| {
-            let r = rays.ray(x as f32 + 0.5, y as f32 + 0.5);
-            for _ in 0..reps {
-                scene
-                    .geometry
-                    .all_hits(r.origin, r.dir, f32::INFINITY, hits);
-                std::hint::black_box(hits.len());
-            }
-        })
-    });
-    let n = (pixels.len() * reps as usize) as f64;
+        .collect();
     let mut figures = json!({
         "threads": rayon::current_num_threads(),
         "size": BENCH_RES,
         "spp": cfg.render.spp,
-        "closest_mrays_per_s": n / closest / 1e6,
-        "all_hits_mrays_per_s": n / all / 1e6,
-        "all_hits_cost_ratio": all / closest,
     });
-    lfformat::say!(
-        "closest hit (stochastic opacity): {:.2} Mrays/s",
-        n / closest / 1e6
-    )?;
-    lfformat::say!(
-        "all hits (anyhit + sort + dedupe): {:.2} Mrays/s",
-        n / all / 1e6
-    )?;
-    lfformat::say!("all_hits_cost_ratio: {:.3}", all / closest)?;
+    traversal(&scene, &camera, &mut figures)?;
     let job = RenderJob::from_config(&cfg, "");
     let settings = job.settings(&desc);
     let counter = AtomicU64::new(0);
@@ -139,6 +108,144 @@ pub fn speed(cfg: &Config) -> Result<Value> {
     figures["gt_overhead_ratio"] = json!(ratio);
     Ok(figures)
 }
+
+/// Repetitions of every query in [`traversal`], so each timing covers well over a second.
+const REPS: u32 = 8;
+
+/// Mrays/s of each kind of query the renderer makes, into `figures`: closest hits and all
+/// hits (the ground truth's query) of the camera rays, the most coherent rays there are;
+/// closest hits of cosine-distributed rays from the camera rays' first surfaces (the path's
+/// incoherent bounces); and shadow rays from those surfaces to a sampled point on a light.
+fn traversal(scene: &RenderScene, camera: &[(Vec3, Vec3)], figures: &mut Value) -> Result<()> {
+    let geo = &scene.geometry;
+    let key = |k: u32| RayKey {
+        hash: u64::from(k),
+        phase: 0.0,
+    };
+    let closest = |rays: &[(Vec3, Vec3)]| {
+        time(|| {
+            rays.par_iter().for_each(|&(o, d)| {
+                for k in 0..REPS {
+                    black_box(geo.closest(&scene.materials, o, d, f32::INFINITY, key(k)));
+                }
+            })
+        })
+    };
+    let coherent = closest(camera);
+    let all = time(|| {
+        camera.par_iter().for_each_init(Vec::new, |hits, &(o, d)| {
+            for _ in 0..REPS {
+                geo.all_hits(o, d, f32::INFINITY, hits);
+                black_box(hits.len());
+            }
+        })
+    });
+    let surfaces = first_surfaces(scene, camera);
+    let bounces: Vec<(Vec3, Vec3)> = surfaces
+        .iter()
+        .enumerate()
+        .map(|(i, &(p, n))| {
+            let u = sample(i, 0).next2();
+            (
+                p,
+                Frame::from_normal(n).to_world(cosine_sample_hemisphere(u)),
+            )
+        })
+        .collect();
+    let incoherent = closest(&bounces);
+    rate(
+        figures,
+        "closest_mrays_per_s",
+        "closest hit, camera rays (stochastic opacity)",
+        camera.len(),
+        coherent,
+    )?;
+    rate(
+        figures,
+        "all_hits_mrays_per_s",
+        "all hits, camera rays (anyhit + sort + dedupe)",
+        camera.len(),
+        all,
+    )?;
+    rate(
+        figures,
+        "incoherent_closest_mrays_per_s",
+        "closest hit, cosine bounces from the first surfaces",
+        bounces.len(),
+        incoherent,
+    )?;
+    figures["all_hits_cost_ratio"] = json!(all / coherent);
+    lfformat::say!("all_hits_cost_ratio: {:.3}", all / coherent)?;
+    if scene.lights.is_empty() {
+        return Ok(lfformat::say!(
+            "shadow rays: the scene has no emissive surface to aim at"
+        )?);
+    }
+    let shadows: Vec<(Vec3, Vec3, f32)> = surfaces
+        .iter()
+        .enumerate()
+        .map(|(i, &(p, _))| {
+            let mut s = sample(i, 1);
+            let light = scene
+                .lights
+                .sample(geo, &scene.materials, p, s.next_f32(), s.next2());
+            let to = light.p - p;
+            (p, to.normalize(), to.length() * (1.0 - 1e-4))
+        })
+        .collect();
+    let shadow = time(|| {
+        shadows.par_iter().for_each(|&(o, d, t)| {
+            for _ in 0..REPS {
+                black_box(geo.transmittance(&scene.materials, o, d, t, false));
+            }
+        })
+    });
+    rate(
+        figures,
+        "shadow_mrays_per_s",
+        "shadow rays to a light sample (any hit, early exit)",
+        shadows.len(),
+        shadow,
+    )
+}
+
+/// Records and prints the rate of `rays` queries, each repeated [`REPS`] times, in `seconds`.
+fn rate(figures: &mut Value, name: &str, label: &str, rays: usize, seconds: f64) -> Result<()> {
+    let mrays = (rays * REPS as usize) as f64 / seconds / 1e6;
+    figures[name] = json!(mrays);
+    Ok(lfformat::say!("{label}: {mrays:.2} Mrays/s")?)
+}
+
+/// Where the camera rays first meet an opaque-enough surface, each lifted off it along its
+/// normal turned towards the camera: the origins of the secondary queries.
+fn first_surfaces(scene: &RenderScene, camera: &[(Vec3, Vec3)]) -> Vec<(Vec3, Vec3)> {
+    let geo = &scene.geometry;
+    let key = RayKey {
+        hash: 0,
+        phase: 0.0,
+    };
+    camera
+        .iter()
+        .filter_map(|&(o, d)| {
+            let hit = geo.closest(&scene.materials, o, d, f32::INFINITY, key)?;
+            let n = geo.geometric_normal(hit.tri);
+            let n = if n.dot(d) > 0.0 { -n } else { n };
+            let p = o + d * hit.t;
+            Some((p + n * 1e-4 * p.abs().max_element().max(1.0), n))
+        })
+        .collect()
+}
+
+/// The bench's random numbers for surface `i`, stream `stream`: fixed, so every run and
+/// binary traces the same rays.
+fn sample(i: usize, stream: u32) -> Sampler {
+    let mut s = Sampler::new(BENCH_SEED, 0, stream, i as u32, 0, 1);
+    s.start_sample(0);
+    s
+}
+
+/// Seed of [`sample`].
+const BENCH_SEED: u64 = 0xBE7C;
 
 fn time(f: impl FnOnce()) -> f64 {
     let t = Instant::now();

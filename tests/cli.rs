@@ -495,6 +495,39 @@ fn the_quality_bench_scores_both_shadings_with_their_error_budget() {
     assert!(stderr(&small).contains("--size"), "{}", stderr(&small));
 }
 
+/// `lfgen bench speed` writes one record with a rate for every kind of ray query the
+/// renderer makes (built-in scene 0 has ceiling lights, so shadow rays are measured too) and
+/// the ground truth's cost; the figures are rates, not pass/fail thresholds.
+#[test]
+fn the_speed_bench_records_every_query_kind() {
+    let dir = tmp();
+    let results = dir.path().join("results.jsonl");
+    let extra = [
+        "-q",
+        "--set",
+        "render.spp=1",
+        "--results",
+        results.to_str().unwrap(),
+    ];
+    ok(lfgen(&["bench", "speed"], &extra));
+    let text = fs::read_to_string(&results).unwrap();
+    let record: serde_json::Value = serde_json::from_str(text.trim_end()).unwrap();
+    let figures = &record["figures"];
+    for key in [
+        "closest_mrays_per_s",
+        "all_hits_mrays_per_s",
+        "incoherent_closest_mrays_per_s",
+        "shadow_mrays_per_s",
+        "all_hits_cost_ratio",
+        "gt_overhead_ratio",
+    ] {
+        let value = figures[key]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{key} in {record}"));
+        assert!(value.is_finite() && value > 0.0, "{key} = {value}");
+    }
+}
+
 /// A dataset of any size from 2 scenes on has a val/ split (the last scene below 11 scenes),
 /// shards agree on it, and the run ends by saying where the data is and what to run next; one
 /// scene says why there is no val/. `lfgen generate` is bare `lfgen`.
