@@ -1,8 +1,9 @@
 //! Photometric augmentations of the thesis (§5.3.1): a rotation of the colours in RGB space and
 //! random brightness and contrast; and, not in the thesis, the degradations of a real camera
 //! ([`Degrade`]: blur, vignetting, sensor noise and JPEG), so that a net trained on clean
-//! rendered views keeps working on noisy captured ones. The geometric augmentations (EPI shift, 90° rotation,
-//! down-scaling) live with the geometry in [`lfdata::stacks`] and [`lfdata::lightfield`].
+//! rendered views keeps working on noisy captured ones. The geometric augmentations (EPI
+//! shift, 90° rotation, down-scaling) live with the geometry in [`lfdata::stacks`] and
+//! [`lfdata::lightfield`].
 
 use image::RgbImage;
 use lfdata::camera::{Vignette, jpeg_round_trip};

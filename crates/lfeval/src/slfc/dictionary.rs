@@ -28,7 +28,7 @@
 //! scaled to unit root mean square, so its coefficient is an amplitude in intensity units and
 //! the authors' `α = 0.01` is one percent of the intensity range.
 
-use nalgebra::{DMatrix, SymmetricEigen};
+use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
 use super::lasso::Gram;
 
@@ -131,7 +131,7 @@ impl Generators {
         energy: f64,
     ) -> Self {
         let basis = support - 1;
-        let dct = dct_matrix(support);
+        let dct = coordinates(support);
         let mut cov = DMatrix::<f64>::zeros(basis, basis);
         let (along, across) = if horizontal {
             (width, height)
@@ -139,8 +139,8 @@ impl Generators {
             (height, width)
         };
         let half = support / 2;
-        let mut profile = vec![0.0f64; support];
-        let mut coords = nalgebra::DVector::<f64>::zeros(basis);
+        let mut profile = DVector::<f64>::zeros(support);
+        let mut coords = DVector::<f64>::zeros(basis);
         // Profiles that reach past the border repeat its pixel, a shape no surface has: they
         // are left out unless the image is shorter than the support.
         let centres = if along >= support {
@@ -160,13 +160,7 @@ impl Generators {
                         }],
                     );
                 }
-                for (k, o) in coords.iter_mut().enumerate() {
-                    *o = dct[k * support..(k + 1) * support]
-                        .iter()
-                        .zip(&profile)
-                        .map(|(b, p)| b * p)
-                        .sum();
-                }
+                coords.gemv(1.0, &dct, &profile, 0.0);
                 cov.syger(1.0, &coords, &coords, 1.0);
             }
         }
@@ -194,25 +188,33 @@ impl Generators {
 
     /// The basis functions at position `t` (`|t| ≤ R`), into `out`.
     fn cosines(&self, t: f64, out: &mut [f64]) {
-        let l = self.support as f64;
-        for (k, o) in out.iter_mut().enumerate() {
-            *o = (std::f64::consts::PI * (k + 1) as f64 / l * (t + l / 2.0)).cos();
-        }
+        basis_at(self.support, t, out);
     }
 }
 
-/// The orthonormal DCT-II basis functions `k = 1 ..= L − 1` at the integer positions
-/// `n = 0 .. L` (`t = n − R`), `(L − 1) × L` row-major: the coordinates of a profile.
-fn dct_matrix(support: usize) -> Vec<f64> {
+/// The DCT-II basis functions `cos(πk(t + L/2)/L)`, `k = 1 ..= L − 1`, of a support of
+/// length `L = support` at position `t` (`|t| ≤ R`), into `out`.
+fn basis_at(support: usize, t: f64, out: &mut [f64]) {
     let l = support as f64;
-    let scale = (2.0 / l).sqrt();
-    (1..support)
-        .flat_map(|k| {
-            (0..support).map(move |n| {
-                scale * (std::f64::consts::PI * k as f64 / l * (n as f64 + 0.5)).cos()
-            })
-        })
-        .collect()
+    for (k, o) in out.iter_mut().enumerate() {
+        *o = (std::f64::consts::PI * (k + 1) as f64 / l * (t + l / 2.0)).cos();
+    }
+}
+
+/// The matrix that takes a profile sampled at the support's integer positions `t = n − R`
+/// to its coordinates: the basis functions there, scaled to be orthonormal (`√(2/L)`).
+fn coordinates(support: usize) -> DMatrix<f64> {
+    let (basis, half) = (support - 1, (support / 2) as f64);
+    let scale = (2.0 / support as f64).sqrt();
+    let mut column = vec![0.0; basis];
+    let mut m = DMatrix::zeros(basis, support);
+    for n in 0..support {
+        basis_at(support, n as f64 - half, &mut column);
+        for (k, c) in column.iter().enumerate() {
+            m[(k, n)] = scale * c;
+        }
+    }
+    m
 }
 
 /// Removes the mean of `v` and scales it to unit root mean square (a flat `v` stays zero).
@@ -308,7 +310,7 @@ mod tests {
             .map(|&t| wave(24.0 + t, 30.0) - 0.5)
             .collect();
         let a = DMatrix::from_fn(positions.len(), 2, |i, j| columns[j][i]);
-        let b = nalgebra::DVector::from_vec(target.clone());
+        let b = DVector::from_vec(target.clone());
         let fit = a
             .clone()
             .svd(true, true)
