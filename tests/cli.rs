@@ -429,6 +429,14 @@ fn rays_through_windows_and_doors_end_on_a_surface() {
     assert_eq!(seen, [true, true], "windows and doors");
 }
 
+/// The one record a benchmark run appended to the results file `path` (asserting it is the
+/// only line).
+fn only_record(path: &Path) -> serde_json::Value {
+    let text = fs::read_to_string(path).unwrap();
+    assert_eq!(text.lines().count(), 1, "{text}");
+    serde_json::from_str(text.trim_end()).unwrap()
+}
+
 /// `lfgen bench quality` end to end at a tiny size: the converged row and both shadings, each
 /// with the share of its error that is its view's own noise, and shared shading's cache noise
 /// share. The independent estimator has no
@@ -481,9 +489,7 @@ fn the_quality_bench_scores_both_shadings_with_their_error_budget() {
         assert!(path.exists(), "{} missing", path.display());
     }
     // The run's figures, as one record of the results file.
-    let text = fs::read_to_string(&results).unwrap();
-    let record: serde_json::Value = serde_json::from_str(text.trim_end()).unwrap();
-    assert_eq!(text.lines().count(), 1, "{text}");
+    let record = only_record(&results);
     assert_eq!(record["tool"], "lfgen");
     assert_eq!(record["command"][1], "bench", "{record}");
     let rows = record["figures"]["rows"].as_array().unwrap();
@@ -510,8 +516,7 @@ fn the_speed_bench_records_every_query_kind() {
         results.to_str().unwrap(),
     ];
     ok(lfgen(&["bench", "speed"], &extra));
-    let text = fs::read_to_string(&results).unwrap();
-    let record: serde_json::Value = serde_json::from_str(text.trim_end()).unwrap();
+    let record = only_record(&results);
     let figures = &record["figures"];
     for key in [
         "closest_mrays_per_s",
