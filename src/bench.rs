@@ -58,15 +58,15 @@ pub fn speed(cfg: &Config) -> Result<Value> {
     });
     traversal(&scene, &camera, &mut figures)?;
     let job = RenderJob::from_config(&cfg, "");
-    let settings = job.settings(&desc);
+    let settings = job.render.view_settings(&desc);
     let counter = AtomicU64::new(0);
     // The configured shading's cache, filled once (its cost is the scene's, not the GT's).
-    let cache = (job.shading == ShadingMode::Shared)
-        .then(|| job.fill_cache(&scene, cam, &settings, &counter));
+    let cache = (job.render.shading == ShadingMode::Shared)
+        .then(|| scene.fill_shared_cache(cam, &job.render, &settings, &counter));
     let configured = cache.as_ref().map_or(Shading::Independent, Shading::read);
     let samples = (pixels.len() as u64 * cfg.render.spp as u64) as f64;
     let mut ratio = 0.0;
-    let configured_name = format!("{:?}", job.shading).to_lowercase();
+    let configured_name = format!("{:?}", job.render.shading).to_lowercase();
     let rows = [
         ("independent", Shading::Independent),
         (&configured_name, configured),
@@ -287,7 +287,7 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
             gt_spp: spp,
             seed: desc.seed ^ salt,
             adaptive: Adaptive::default(),
-            ..job.settings(&desc)
+            ..job.render.view_settings(&desc)
         };
         let [a, b] = [REFERENCE_SALT, REFERENCE_SALT + 1].map(|salt| {
             let s = converged(salt, REFERENCE_SPP / 2);
@@ -364,13 +364,13 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
             "photo_residual": floor,
         }));
         for shading in [ShadingMode::Shared, ShadingMode::Independent] {
-            job.shading = shading;
-            let mut settings = job.settings(&desc);
+            job.render.shading = shading;
+            let mut settings = job.render.view_settings(&desc);
             // As in a dataset: adaptive sampling's noise in the final exposure's display units.
             settings.adaptive.display_scale = exposure;
             let started = Instant::now();
             let cache = (shading == ShadingMode::Shared)
-                .then(|| job.fill_cache(&scene, cam, &settings, &counter));
+                .then(|| scene.fill_shared_cache(cam, &job.render, &settings, &counter));
             let fill = started.elapsed().as_secs_f64();
             let mode = cache.as_ref().map_or(Shading::Independent, Shading::read);
             let render = |settings: &RenderSettings, view| {
@@ -418,7 +418,7 @@ pub fn quality(cfg: &Config, scenes: &[u64], size: u32, images: Option<&Path>) -
                         seed: settings.seed ^ CACHE_SALT,
                         ..settings
                     };
-                    let other = job.fill_cache(&scene, cam, &fill, &counter);
+                    let other = scene.fill_shared_cache(cam, &job.render, &fill, &counter);
                     let out = scene.render_view_with(
                         cam,
                         &desc.slices,

@@ -9,6 +9,7 @@ use crate::camera::LightFieldCamera;
 use crate::output::images::ToneCurve;
 pub use crate::procgen::settings::RoomSettings as SceneConfig;
 pub use crate::render::integrator::GlassLight;
+pub use crate::render::light_field::{GtViews, ShadingMode};
 pub use crate::render::sensor::SensorSettings as SensorConfig;
 pub use crate::render::slices::SliceAssignment;
 pub use crate::scene::SliceSpacing;
@@ -145,25 +146,6 @@ impl CameraConfig {
     }
 }
 
-/// Which views get multimodal ground truth.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum GtViews {
-    Center,
-    All,
-}
-
-/// How the light leaving a surface is estimated across the views of a light field.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum ShadingMode {
-    /// The view-independent (diffuse) light is estimated once from the samples of every view
-    /// and shared by all of them; the glossy lobe and delta surfaces stay per view.
-    Shared,
-    /// Every view is path-traced on its own: the unbiased reference.
-    Independent,
-}
-
 /// Path tracer and ground-truth settings.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -210,10 +192,10 @@ pub struct RenderConfig {
     /// `shared` (default) or `independent` shading (see [`ShadingMode`]).
     pub shading: ShadingMode,
     /// Shared shading: fill samples per pixel of every view, at least; raised to
-    /// ⌈spp / views⌉ so the cache's noise shrinks with spp (`RenderJob::fill_spp`).
+    /// ⌈spp / views⌉ so the cache's noise shrinks with spp (`LightFieldSettings::fill_spp`).
     pub cache_spp: u32,
     /// Shared shading: cache cell size in pixels of the centre view at the cell's depth, at
-    /// least; widened until a cell gathers 256 fill samples (`RenderJob::cache_params`).
+    /// least; widened until a cell gathers 256 fill samples (`LightFieldSettings::cache_params`).
     pub cache_cell: f64,
     /// Shared shading: glossy lobes at least this many times as wide as the camera grid's
     /// angle at a point are shared by all views (see `render::cache`).

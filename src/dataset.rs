@@ -95,7 +95,7 @@ pub fn generate(cfg: &Config, opts: &GenerateOptions) -> Result<()> {
     let library = open_library(cfg, opts.strict)?;
     let [w, h] = cfg.camera.resolution;
     let views = cfg.camera.grid[0] * cfg.camera.grid[1];
-    let per_scene = w as u64 * h as u64 * job.samples_per_pixel(views);
+    let per_scene = w as u64 * h as u64 * job.render.samples_per_pixel(views);
     let bar = progress_bar(todo.len() as u64 * per_scene, opts.quiet);
     let samples = AtomicU64::new(0);
     let (mut done, mut skipped, mut unsaved) = (0, 0, false);

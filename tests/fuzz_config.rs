@@ -83,7 +83,9 @@ fn run_in_process(text: &str, file: &Path) -> Outcome {
             return Outcome::Ungenerated;
         }
     };
-    let mut settings = RenderJob::from_config(&cfg, "2026-01-01").settings(&desc);
+    let mut settings = RenderJob::from_config(&cfg, "2026-01-01")
+        .render
+        .view_settings(&desc);
     settings.spp = 1;
     desc.camera.resolution = [8, 8];
     let centre = desc.camera.center_view();

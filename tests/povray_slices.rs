@@ -500,7 +500,9 @@ fn slice_renders_composited_with_over_match_the_single_pass_ground_truth() {
     let written = read_modes_exr(&scene_dir.join("modes.exr")).unwrap();
     let sets: Vec<String> = SETS.iter().map(|s| s.to_string()).collect();
     let cfg = Config::load(None, &[], &sets).unwrap();
-    let mut settings = RenderJob::from_config(&cfg, "2026-01-01").settings(&desc);
+    let mut settings = RenderJob::from_config(&cfg, "2026-01-01")
+        .render
+        .view_settings(&desc);
     let render = |settings: &RenderSettings| {
         let t = Instant::now();
         let out = scene.render_view(

@@ -3,7 +3,7 @@
 //! them, deterministically (no random numbers, so scenes without them draw the same streams).
 
 use super::RenderScene;
-use super::bsdf::{Frame, Lobes, power_heuristic};
+use super::bsdf::{Bsdf, BsdfSample, Frame, Lobes, power_heuristic};
 use super::cache::{Anchor, COARSER, CacheGrid, Estimate, MAX_FILL_VERTICES, RadianceCache};
 use super::geometry::Hit;
 use super::sampler::Sampler;
@@ -129,7 +129,7 @@ struct Vertex<'a> {
     hit: &'a Hit,
     frame: &'a Frame,
     wo_l: Vec3,
-    bsdf: &'a super::bsdf::Bsdf,
+    bsdf: &'a Bsdf,
     /// Shadow rays pass through smooth glass ([`GlassLight::Shadows`]).
     through_glass: bool,
 }
@@ -241,6 +241,187 @@ impl Later {
 /// under a bright lobe would blow up into fireflies in the cell.
 const LATER_MAX_GLOSSY: f32 = 0.5;
 
+/// What a path's role ([`Shading`]) fixes for all its vertices.
+struct Role<'a> {
+    /// The grid of a fill path, whose later vertices open estimates of their own (a
+    /// gathering path's do not: their light is the prior's).
+    fill_grid: Option<&'a CacheGrid>,
+    /// The cache a reading (or gathering) path reads, and the view it is seen from.
+    read: Option<(&'a RadianceCache, Vec2)>,
+    /// The most later-vertex estimates the path opens.
+    later_max: usize,
+    /// Light reached by refraction after a surface vertex is dropped ([`GlassLight`]).
+    drop_caustics: bool,
+    /// Shadow rays pass through smooth glass ([`GlassLight::Shadows`]).
+    through_glass: bool,
+}
+
+impl<'a> Role<'a> {
+    fn of(shading: Shading<'a>, settings: &PathSettings) -> Self {
+        let (fill_grid, read) = match shading {
+            Shading::Independent => (None, None),
+            Shading::Fill(grid) => (Some(grid), None),
+            Shading::Read { cache, view } => (None, Some((cache, view))),
+            Shading::Gather { grid, prior, view } => (Some(grid), Some((prior, view))),
+        };
+        let later_max = match shading {
+            Shading::Fill(grid) => grid.fill_vertices as usize - 1,
+            _ => 0,
+        };
+        Self {
+            fill_grid,
+            read,
+            later_max,
+            drop_caustics: settings.glass_light != GlassLight::Caustics,
+            through_glass: settings.glass_light == GlassLight::Shadows,
+        }
+    }
+}
+
+/// What a path carries from vertex to vertex.
+struct PathState {
+    radiance: Vec3,
+    /// Throughput.
+    beta: Vec3,
+    arrival: Arrival,
+    /// The shared cache still has its part at the next non-delta vertex ([`RenderScene::first_vertex`]).
+    pending: bool,
+    /// A fill path's estimate: its cells, whether it is the glossy term, where it lies.
+    fill: Option<([u64; COARSER + 1], bool, Anchor)>,
+    later: Later,
+    /// The loop depth of the fill's first vertex.
+    first_depth: u32,
+    /// Camera-ray length so far while only delta vertices were passed (texture filter).
+    camera_length: Option<f32>,
+    /// Whether the path left a surface vertex (one with a light sample) and has refracted
+    /// through glass since: light it reaches now is a refractive caustic.
+    left_surface: bool,
+    refracted: bool,
+    /// The coupled-irradiance share of the current vertex's light samples ([`Later`]).
+    direct: Vec3,
+}
+
+impl PathState {
+    fn new(start: &Start, shading: Shading) -> Self {
+        Self {
+            radiance: Vec3::ZERO,
+            beta: Vec3::ONE,
+            arrival: Arrival {
+                pdf: 0.0,
+                is_delta: true,
+                from: start.origin,
+            },
+            pending: !matches!(shading, Shading::Independent),
+            fill: None,
+            later: Later::default(),
+            first_depth: 0,
+            camera_length: Some(start.camera_length),
+            left_surface: false,
+            refracted: false,
+            direct: Vec3::ZERO,
+        }
+    }
+
+    /// Light `l` the path hits on arriving at loop depth `depth` (an emitter, the
+    /// environment): its own while it `arrives`, and its open estimates'.
+    fn arrive(&mut self, l: Vec3, depth: u32, arrives: bool) {
+        if arrives {
+            self.radiance += self.beta * l;
+        }
+        self.later.arrive(l, depth);
+    }
+
+    /// A light sample's light `l` and coupled share `coupled` at a vertex at `depth`, one of
+    /// the path's `own` or serving only its open estimates.
+    fn gather(&mut self, l: Vec3, coupled: Vec3, depth: u32, own: bool) {
+        if own {
+            self.radiance += self.beta * l;
+        }
+        self.later.gather(l, depth);
+        self.direct += coupled;
+    }
+
+    /// Notes the lobe `bs` the path took at a vertex (delta or not) seen from `wo_l`.
+    fn passed(&mut self, bs: &BsdfSample, vertex_is_delta: bool, wo_l: Vec3) {
+        if !bs.is_delta {
+            self.camera_length = None;
+        }
+        if vertex_is_delta {
+            self.refracted |= self.left_surface && bs.wi.z * wo_l.z < 0.0;
+        } else {
+            (self.left_surface, self.refracted) = (true, false);
+        }
+    }
+
+    /// Russian roulette after the vertex at `depth`; false ends the path. It keeps the path as
+    /// likely as its largest weight asks, the open estimates' included: their weight is not
+    /// the path's (it restarts at each).
+    fn roulette(&mut self, depth: u32, own: bool, sampler: &mut Sampler) -> bool {
+        let own_weight = if own { self.beta.max_element() } else { 0.0 };
+        let survive = own_weight.max(self.later.weight_beyond(depth)).min(0.95);
+        if sampler.next_f32() >= survive {
+            return false;
+        }
+        self.beta /= survive;
+        self.later.scale(Vec3::splat(survive.recip()));
+        true
+    }
+
+    fn traced(self) -> Traced {
+        let radiance = self.radiance;
+        let estimate = |glossy| match glossy {
+            true => Estimate::Glossy(radiance),
+            false => Estimate::Irradiance(radiance),
+        };
+        Traced {
+            radiance,
+            fill: (self.fill).map(|(cells, glossy, at)| (cells, estimate(glossy), at)),
+            later: self.later,
+        }
+    }
+}
+
+/// A surface vertex as the path met it.
+struct Surface {
+    p: Vec3,
+    material: u32,
+    bsdf: Bsdf,
+    frame: Frame,
+    wo_l: Vec3,
+}
+
+/// How a vertex is shaded.
+struct Plan {
+    /// The lobes its light samples and continuation take.
+    lobes: Lobes,
+    /// Probability that it continues by BSDF sampling (below 1 only for the glossy lobe of a
+    /// cached vertex): the BSDF strategy's pdf for MIS is scaled by it.
+    select: f32,
+    /// Light samples it averages (more only at a fill path's first vertex).
+    light_samples: u32,
+    /// It opens a later-vertex estimate of its own ([`Later`]).
+    opens: bool,
+    /// It is one of the path's own vertices (else it serves only the open estimates).
+    own: bool,
+}
+
+/// What the shared cache leaves a path to do at its first non-delta vertex.
+enum First {
+    /// Nothing: the cache holds all its light.
+    Done,
+    /// Shade it with these lobes, selection probability and light samples ([`Plan`]).
+    Shade(Lobes, f32, u32),
+}
+
+/// What a path's continuation needs besides the vertex.
+struct Scatter<'a> {
+    settings: &'a PathSettings,
+    start: &'a Start,
+    shading: Shading<'a>,
+    plan: &'a Plan,
+    depth: u32,
+}
+
 impl RenderScene {
     /// Radiance arriving along `dir` at `origin`, given the first surface already chosen
     /// (`first`, from the caller's traversal; `None` means the ray escaped).
@@ -278,7 +459,10 @@ impl RenderScene {
     }
 
     /// [`Self::trace`] of a path that starts at loop depth `start.depth`: a camera path, or
-    /// the reflection branch of a camera path's glass ([`Self::reflection`]).
+    /// the reflection branch of a camera path's glass ([`Self::reflection`]). Each pass of the
+    /// loop is one vertex: the light the path arrives with ([`PathState::arrive`]), the shared
+    /// cache's part at the first non-delta vertex ([`Self::first_vertex`]), next-event
+    /// estimation ([`Self::next_event`]) and the continuation ([`Self::scatter`]).
     fn trace_from(
         &self,
         settings: &PathSettings,
@@ -286,37 +470,9 @@ impl RenderScene {
         sampler: &mut Sampler,
         shading: Shading,
     ) -> Traced {
+        let role = Role::of(shading, settings);
+        let mut path = PathState::new(&start, shading);
         let (mut origin, mut dir, mut hit) = (start.origin, start.dir, start.first);
-        let mut radiance = Vec3::ZERO;
-        let mut beta = Vec3::ONE;
-        let mut arrival = Arrival {
-            pdf: 0.0,
-            is_delta: true,
-            from: origin,
-        };
-        let (mut pending, mut fill) = (!matches!(shading, Shading::Independent), None);
-        let mut later = Later::default();
-        // The loop depth of the fill's first vertex.
-        let mut first_depth = 0;
-        // The grid of a fill path, whose later vertices open estimates of their own (a
-        // gathering path's do not: their light is the prior's).
-        let (fill_grid, read) = match shading {
-            Shading::Independent => (None, None),
-            Shading::Fill(grid) => (Some(grid), None),
-            Shading::Read { cache, view } => (None, Some((cache, view))),
-            Shading::Gather { grid, prior, view } => (Some(grid), Some((prior, view))),
-        };
-        let later_max = match shading {
-            Shading::Fill(grid) => grid.fill_vertices as usize - 1,
-            _ => 0,
-        };
-        // Camera-ray length so far while only delta vertices were passed (texture filter).
-        let mut camera_length = Some(start.camera_length);
-        // Whether the path left a surface vertex (one with a light sample) and has refracted
-        // through glass since: light it reaches now is a refractive caustic.
-        let (mut left_surface, mut refracted) = (false, false);
-        let drop_caustics = settings.glass_light != GlassLight::Caustics;
-        let through_glass = settings.glass_light == GlassLight::Shadows;
         // One pass more than `max_depth` vertices: the last vertex's BSDF-sampled ray only
         // picks up the light it hits, the MIS partner of that vertex's light sample (as pbrt
         // and Mitsuba do). A light sample taking all the direct light alone instead would be
@@ -328,210 +484,70 @@ impl RenderScene {
             // Whether the path's own estimate still takes the light it reaches here.
             let arrives = depth <= settings.max_depth;
             let Some(h) = hit else {
-                if arrives {
-                    radiance += beta * self.environment;
-                }
-                later.arrive(self.environment, depth);
+                path.arrive(self.environment, depth, arrives);
                 break;
             };
-            if !(drop_caustics && refracted) {
-                let emitted = self.emitted(&h, dir, arrival);
-                if arrives {
-                    radiance += beta * emitted;
-                }
-                later.arrive(emitted, depth);
+            if !(role.drop_caustics && path.refracted) {
+                path.arrive(self.emitted(&h, dir, path.arrival), depth, arrives);
             }
             // Whether this vertex is one of the path's own (else it serves the open estimates).
             let own = depth < settings.max_depth;
-            if !own && !later.open_beyond(depth) {
+            if !own && !path.later.open_beyond(depth) {
                 break;
             }
-            let p = origin + dir * h.t;
-            let s = &self.geometry.shading[h.tri as usize];
-            let mat = &self.materials[s.material as usize];
-            let wo = -dir.normalize();
-            let width = camera_length.map_or(0.0, |len| {
-                let len = len + h.t * dir.length();
-                camera_length = Some(len);
-                let cos = wo.dot(self.geometry.geometric_normal(h.tri)).abs();
-                len * settings.footprint / cos.max(0.05).sqrt()
-            });
-            let bsdf = mat.surface_filtered(self.geometry.uv(&h), width).bsdf();
-            let frame = Frame::from_normal(self.shading_normal(&h, wo, mat.glass_ior.is_some()));
-            let wo_l = frame.to_local(wo);
-            let mut lobes = Lobes::All;
-            // Probability that this vertex continues by BSDF sampling (below 1 only for the
-            // glossy lobe of a cached vertex): the BSDF strategy's pdf for MIS is scaled by it.
-            let mut select = 1.0;
-            // Light samples this vertex averages (more only at a fill path's first vertex).
-            let mut light_samples = 1;
+            let surface = self.surface(settings, &h, origin, dir, &mut path.camera_length);
+            let (bsdf, wo_l) = (&surface.bsdf, surface.wo_l);
             // A later vertex of a fill path that estimates its coupled irradiance too.
             let opens = own
-                && fill.is_some()
-                && later.len < later_max
+                && path.fill.is_some()
+                && path.later.len < role.later_max
                 && !bsdf.is_delta()
                 && wo_l.z > 0.0
                 && bsdf.specular_probability(wo_l) <= LATER_MAX_GLOSSY;
-            if pending && !bsdf.is_delta() {
-                pending = false;
-                // A fill path opens its estimate at its first such vertex; a reading path (a
-                // gathering one at its next) reads there.
-                match (fill_grid.filter(|_| fill.is_none()), read) {
-                    (None, None) => {}
-                    (Some(grid), _) => {
-                        // From here the path estimates I(p), or the shared glossy term: light
-                        // before it is not part of it.
-                        let glossy = self.fills_glossy(grid, p, &bsdf, wo_l, sampler);
-                        let cells = grid.keys(p, frame.n, s.material);
-                        let anchor = Anchor {
-                            p,
-                            n: frame.n,
-                            material: s.material,
-                        };
-                        fill = Some((cells, glossy, anchor));
-                        first_depth = depth;
-                        light_samples = grid.fill_light_samples;
-                        (radiance, beta, lobes) = match glossy {
-                            true => {
-                                let albedo = bsdf.specular_albedo(wo_l);
-                                (
-                                    Vec3::ZERO,
-                                    albedo.max(Vec3::splat(1e-6)).recip(),
-                                    Lobes::Specular,
-                                )
-                            }
-                            false => (Vec3::ZERO, Vec3::ONE, Lobes::CoupledIrradiance),
-                        };
-                    }
-                    (None, Some((cache, view))) => {
-                        if let Some(c) = cache.lookup(p, frame.n, s.material) {
-                            radiance += beta * bsdf.diffuse_out(wo_l) * c.irradiance;
-                            let q = bsdf.specular_probability(wo_l);
-                            if q <= 0.0 {
-                                break;
-                            }
-                            let width = bsdf.glossy_width();
-                            let shared = c.glossy.filter(|_| cache.grid.shares_glossy(p, width));
-                            if let Some(g) = shared {
-                                radiance += beta * bsdf.specular_albedo(wo_l) * g.at(view);
-                                break;
-                            }
-                            // The glossy lobe per view: its light sample always, its
-                            // continuation as often as the lobe matters.
-                            (select, lobes) = (q, Lobes::Specular);
-                        }
+            let mut plan = Plan {
+                lobes: Lobes::All,
+                select: 1.0,
+                light_samples: 1,
+                opens,
+                own,
+            };
+            if path.pending && !bsdf.is_delta() {
+                path.pending = false;
+                let first = self.first_vertex(&role, &surface, depth, sampler, &mut path);
+                match first {
+                    First::Done => break,
+                    First::Shade(lobes, select, light_samples) => {
+                        (plan.lobes, plan.select, plan.light_samples) =
+                            (lobes, select, light_samples)
                     }
                 }
             }
             let vertex = Vertex {
-                p,
+                p: surface.p,
                 hit: &h,
-                frame: &frame,
+                frame: &surface.frame,
                 wo_l,
-                bsdf: &bsdf,
-                through_glass,
+                bsdf,
+                through_glass: role.through_glass,
             };
-            // The light samples: the path's, and where this vertex opens an estimate the same
-            // samples' coupled-irradiance share.
-            let mut direct = Vec3::ZERO;
-            if !bsdf.is_delta() && !self.lights.is_empty() {
-                let strategy = (lobes, select);
-                let (mut l, mut coupled) = self.direct_light(&vertex, strategy, opens, sampler);
-                if light_samples > 1 {
-                    // The others from a side sequence of their own, stratified among
-                    // themselves. Each is the same MIS-weighted estimator, so their mean keeps
-                    // the weights' sum with the BSDF sample at one.
-                    let mut side = sampler.side(depth);
-                    for k in 1..light_samples {
-                        side.start_sample(k);
-                        let (a, b) = self.direct_light(&vertex, strategy, opens, &mut side);
-                        (l, coupled) = (l + a, coupled + b);
-                    }
-                    let n = light_samples as f32;
-                    (l, coupled) = (l / n, coupled / n);
-                }
-                if own {
-                    radiance += beta * l;
-                }
-                later.gather(l, depth);
-                direct += coupled;
+            self.next_event(&vertex, &plan, depth, sampler, &mut path);
+            if let (true, Some(grid)) = (opens, role.fill_grid) {
+                let cells = grid.keys(surface.p, surface.frame.n, surface.material);
+                let last = depth + settings.max_depth - path.first_depth;
+                path.later.open(cells, path.direct, last);
             }
-            if !bsdf.is_delta() && !self.punctual_lights.is_empty() {
-                let (l, coupled) = self.punctual_light(&vertex, lobes, opens);
-                if own {
-                    radiance += beta * l;
-                }
-                later.gather(l, depth);
-                direct += coupled;
-            }
-            if let (true, Some(grid)) = (opens, fill_grid) {
-                let cells = grid.keys(p, frame.n, s.material);
-                later.open(cells, direct, depth + settings.max_depth - first_depth);
-            }
-            if select < 1.0 {
-                if sampler.next_f32() >= select {
-                    break;
-                }
-                beta /= select;
-            }
-            // Glass on the camera ray is split: the path always refracts, and the reflection
-            // is traced as a branch of its own (see [`Self::reflection`]).
-            let split = start.split && bsdf.is_delta() && camera_length.is_some();
-            let u_lobe = sampler.next_f32();
-            let u_lobe = if split { 1.0 } else { u_lobe };
-            let Some(bs) = bsdf.sample_lobes(wo_l, u_lobe, sampler.next2(), lobes) else {
+            let scattered = Scatter {
+                settings,
+                start: &start,
+                shading,
+                plan: &plan,
+                depth,
+            };
+            let Some(next) = self.scatter(&scattered, &vertex, sampler, &mut path) else {
                 break;
             };
-            if bs.pdf <= 0.0 {
-                break;
-            }
-            let mut f = bs.f * bs.wi.z.abs() / bs.pdf;
-            if split && bs.pdf < 1.0 {
-                // Refraction was sampled with probability `pdf = 1 − F`; split, both branches
-                // carry their throughput `f cos` instead of being chosen with their pdf.
-                f *= bs.pdf;
-                let length = camera_length.unwrap_or(0.0);
-                radiance +=
-                    beta * self.reflection(settings, &vertex, depth, length, sampler, shading);
-            }
-            beta *= f;
-            later.scale(f);
-            if opens {
-                let (coupling, _) = bsdf.eval_lobes(wo_l, bs.wi, Lobes::CoupledIrradiance);
-                later.weigh_newest(coupling * bs.wi.z.abs() / bs.pdf);
-            }
-            if !bs.is_delta {
-                camera_length = None;
-            }
-            if bsdf.is_delta() {
-                refracted |= left_surface && bs.wi.z * wo_l.z < 0.0;
-            } else {
-                (left_surface, refracted) = (true, false);
-            }
-            // A glossy continuation from a cached vertex reads the cache again at its next
-            // non-delta vertex, as a camera path through glass does: only the lobe is per view.
-            pending |= lobes == Lobes::Specular && matches!(shading, Shading::Read { .. });
-            // A gathering path reads the prior at its next non-delta vertex.
-            pending |= matches!(shading, Shading::Gather { .. }) && depth == first_depth;
-            arrival = Arrival {
-                pdf: bs.pdf * select,
-                is_delta: bs.is_delta,
-                from: p,
-            };
-            if depth + 1 >= settings.rr_depth {
-                // The roulette keeps the path as likely as its largest weight asks, the open
-                // estimates' included: their weight is not the path's (it restarts at each).
-                let own_weight = if own { beta.max_element() } else { 0.0 };
-                let survive = own_weight.max(later.weight_beyond(depth)).min(0.95);
-                if sampler.next_f32() >= survive {
-                    break;
-                }
-                beta /= survive;
-                later.scale(Vec3::splat(survive.recip()));
-            }
-            dir = frame.to_world(bs.wi);
-            origin = self.spawn(p, h.tri, dir);
-            hit = self.geometry.closest(
+            (origin, dir) = next;
+            hit = (self.geometry).closest(
                 &self.materials,
                 origin,
                 dir,
@@ -539,15 +555,199 @@ impl RenderScene {
                 sampler.next_key(),
             );
         }
-        let estimate = |glossy| match glossy {
-            true => Estimate::Glossy(radiance),
-            false => Estimate::Irradiance(radiance),
-        };
-        Traced {
-            radiance,
-            fill: fill.map(|(cells, glossy, at)| (cells, estimate(glossy), at)),
-            later,
+        path.traced()
+    }
+
+    /// The surface a path meets at `h` on its ray from `origin` along `dir`, with its BSDF
+    /// filtered over the camera ray's footprint while `camera_length` (the camera ray's length
+    /// so far, while only delta vertices were passed) is known; it grows by this segment.
+    fn surface(
+        &self,
+        settings: &PathSettings,
+        h: &Hit,
+        origin: Vec3,
+        dir: Vec3,
+        camera_length: &mut Option<f32>,
+    ) -> Surface {
+        let p = origin + dir * h.t;
+        let material = self.geometry.shading[h.tri as usize].material;
+        let mat = &self.materials[material as usize];
+        let wo = -dir.normalize();
+        let width = camera_length.map_or(0.0, |len| {
+            let len = len + h.t * dir.length();
+            *camera_length = Some(len);
+            let cos = wo.dot(self.geometry.geometric_normal(h.tri)).abs();
+            len * settings.footprint / cos.max(0.05).sqrt()
+        });
+        let bsdf = mat.surface_filtered(self.geometry.uv(h), width).bsdf();
+        let frame = Frame::from_normal(self.shading_normal(h, wo, mat.glass_ior.is_some()));
+        let wo_l = frame.to_local(wo);
+        Surface {
+            p,
+            material,
+            bsdf,
+            frame,
+            wo_l,
         }
+    }
+
+    /// The shared cache's part at a path's first non-delta vertex: a fill path opens its
+    /// estimate there (and restarts its radiance and throughput: light before the vertex is
+    /// not part of it), a reading path reads the cache (and ends where the cache holds all
+    /// the vertex's light).
+    fn first_vertex(
+        &self,
+        role: &Role,
+        surface: &Surface,
+        depth: u32,
+        sampler: &mut Sampler,
+        path: &mut PathState,
+    ) -> First {
+        let (p, n, bsdf, wo_l) = (surface.p, surface.frame.n, &surface.bsdf, surface.wo_l);
+        let material = surface.material;
+        let all = First::Shade(Lobes::All, 1.0, 1);
+        // A fill path opens its estimate at its first such vertex; a reading path (a gathering
+        // one at its next) reads there.
+        match (role.fill_grid.filter(|_| path.fill.is_none()), role.read) {
+            (None, None) => all,
+            (Some(grid), _) => {
+                // From here the path estimates I(p), or the shared glossy term.
+                let glossy = self.fills_glossy(grid, p, bsdf, wo_l, sampler);
+                let cells = grid.keys(p, n, material);
+                path.fill = Some((cells, glossy, Anchor { p, n, material }));
+                path.first_depth = depth;
+                path.radiance = Vec3::ZERO;
+                let lobes = match glossy {
+                    true => {
+                        let albedo = bsdf.specular_albedo(wo_l);
+                        path.beta = albedo.max(Vec3::splat(1e-6)).recip();
+                        Lobes::Specular
+                    }
+                    false => {
+                        path.beta = Vec3::ONE;
+                        Lobes::CoupledIrradiance
+                    }
+                };
+                First::Shade(lobes, 1.0, grid.fill_light_samples)
+            }
+            (None, Some((cache, view))) => {
+                let Some(c) = cache.lookup(p, n, material) else {
+                    return all;
+                };
+                path.radiance += path.beta * bsdf.diffuse_out(wo_l) * c.irradiance;
+                let q = bsdf.specular_probability(wo_l);
+                if q <= 0.0 {
+                    return First::Done;
+                }
+                let width = bsdf.glossy_width();
+                if let Some(g) = c.glossy.filter(|_| cache.grid.shares_glossy(p, width)) {
+                    path.radiance += path.beta * bsdf.specular_albedo(wo_l) * g.at(view);
+                    return First::Done;
+                }
+                // The glossy lobe per view: its light sample always, its continuation as
+                // often as the lobe matters.
+                First::Shade(Lobes::Specular, q, 1)
+            }
+        }
+    }
+
+    /// Next-event estimation at `v`: the light samples of the emitters and every punctual
+    /// light, added to the path's radiance (at its own vertices) and to its open estimates;
+    /// where this vertex opens an estimate, the same samples' coupled-irradiance share goes to
+    /// `path.direct`.
+    fn next_event(
+        &self,
+        v: &Vertex,
+        plan: &Plan,
+        depth: u32,
+        sampler: &mut Sampler,
+        path: &mut PathState,
+    ) {
+        path.direct = Vec3::ZERO;
+        if v.bsdf.is_delta() {
+            return;
+        }
+        if !self.lights.is_empty() {
+            let strategy = (plan.lobes, plan.select);
+            let (mut l, mut coupled) = self.direct_light(v, strategy, plan.opens, sampler);
+            if plan.light_samples > 1 {
+                // The others from a side sequence of their own, stratified among themselves.
+                // Each is the same MIS-weighted estimator, so their mean keeps the weights'
+                // sum with the BSDF sample at one.
+                let mut side = sampler.side(depth);
+                for k in 1..plan.light_samples {
+                    side.start_sample(k);
+                    let (a, b) = self.direct_light(v, strategy, plan.opens, &mut side);
+                    (l, coupled) = (l + a, coupled + b);
+                }
+                let n = plan.light_samples as f32;
+                (l, coupled) = (l / n, coupled / n);
+            }
+            path.gather(l, coupled, depth, plan.own);
+        }
+        if !self.punctual_lights.is_empty() {
+            let (l, coupled) = self.punctual_light(v, plan.lobes, plan.opens);
+            path.gather(l, coupled, depth, plan.own);
+        }
+    }
+
+    /// The path's continuation from `v`: the glossy lobe's selection, a BSDF sample (with
+    /// split glass's reflection branch traced here), the throughput, the roulette; `None`
+    /// where the path ends, else the next ray's origin and direction.
+    fn scatter(
+        &self,
+        s: &Scatter,
+        v: &Vertex,
+        sampler: &mut Sampler,
+        path: &mut PathState,
+    ) -> Option<(Vec3, Vec3)> {
+        let (plan, depth, bsdf, wo_l) = (s.plan, s.depth, v.bsdf, v.wo_l);
+        if plan.select < 1.0 {
+            if sampler.next_f32() >= plan.select {
+                return None;
+            }
+            path.beta /= plan.select;
+        }
+        // Glass on the camera ray is split: the path always refracts, and the reflection is
+        // traced as a branch of its own (see [`Self::reflection`]).
+        let split = s.start.split && bsdf.is_delta() && path.camera_length.is_some();
+        let u_lobe = sampler.next_f32();
+        let u_lobe = if split { 1.0 } else { u_lobe };
+        let bs = bsdf.sample_lobes(wo_l, u_lobe, sampler.next2(), plan.lobes)?;
+        if bs.pdf <= 0.0 {
+            return None;
+        }
+        let mut f = bs.f * bs.wi.z.abs() / bs.pdf;
+        if split && bs.pdf < 1.0 {
+            // Refraction was sampled with probability `pdf = 1 − F`; split, both branches
+            // carry their throughput `f cos` instead of being chosen with their pdf.
+            f *= bs.pdf;
+            let length = path.camera_length.unwrap_or(0.0);
+            let reflected = self.reflection(s.settings, v, depth, length, sampler, s.shading);
+            path.radiance += path.beta * reflected;
+        }
+        path.beta *= f;
+        path.later.scale(f);
+        if plan.opens {
+            let (coupling, _) = bsdf.eval_lobes(wo_l, bs.wi, Lobes::CoupledIrradiance);
+            path.later.weigh_newest(coupling * bs.wi.z.abs() / bs.pdf);
+        }
+        path.passed(&bs, bsdf.is_delta(), wo_l);
+        // A glossy continuation from a cached vertex reads the cache again at its next
+        // non-delta vertex, as a camera path through glass does: only the lobe is per view.
+        path.pending |= plan.lobes == Lobes::Specular && matches!(s.shading, Shading::Read { .. });
+        // A gathering path reads the prior at its next non-delta vertex.
+        path.pending |= matches!(s.shading, Shading::Gather { .. }) && depth == path.first_depth;
+        path.arrival = Arrival {
+            pdf: bs.pdf * plan.select,
+            is_delta: bs.is_delta,
+            from: v.p,
+        };
+        if depth + 1 >= s.settings.rr_depth && !path.roulette(depth, plan.own, sampler) {
+            return None;
+        }
+        let dir = v.frame.to_world(bs.wi);
+        Some((self.spawn(v.p, v.hit.tri, dir), dir))
     }
 
     /// Light the mirror reflection at glass `v` (loop depth `depth`, camera ray `length` long
@@ -598,7 +798,7 @@ impl RenderScene {
         &self,
         grid: &CacheGrid,
         p: Vec3,
-        bsdf: &super::bsdf::Bsdf,
+        bsdf: &Bsdf,
         wo_l: Vec3,
         sampler: &mut Sampler,
     ) -> bool {

@@ -13,6 +13,7 @@ pub mod cache;
 pub mod framing;
 pub mod geometry;
 pub mod integrator;
+pub mod light_field;
 pub mod lights;
 pub mod material;
 pub mod sampler;
