@@ -39,6 +39,59 @@ fn same_seed_is_byte_identical_across_thread_counts_and_seeds_differ() {
     assert_ne!(fa[view], fc[view], "another seed must give another scene");
 }
 
+/// The BVH's node and triangle tests run as scalar, SSE or AVX2 code, chosen at run time
+/// (`LFGEN_SIMD` forces one): every kernel this CPU runs must render the same bytes, the
+/// glass and semi-transparent shadow layers of the test scenes included.
+#[test]
+fn every_simd_kernel_renders_the_same_bytes() {
+    let kernels = lfgen::render::wide::Kernel::available();
+    #[cfg(target_arch = "x86_64")]
+    assert!(kernels.len() >= 2, "x86-64 always has SSE: {kernels:?}");
+    let runs: Vec<(String, BTreeMap<String, Vec<u8>>)> = kernels
+        .iter()
+        .map(|k| {
+            let name = format!("{k:?}").to_lowercase();
+            let dir = tmp();
+            let mut args = vec!["--scenes", "2", "--out", dir.path().to_str().unwrap()];
+            args.extend_from_slice(TINY);
+            let out = Command::new(env!("CARGO_BIN_EXE_lfgen"))
+                .args(&args)
+                .env("LFGEN_SIMD", &name)
+                .output()
+                .expect("lfgen runs");
+            ok(out);
+            (name, files(dir.path()))
+        })
+        .collect();
+    let (first, reference) = &runs[0];
+    for (name, got) in &runs[1..] {
+        assert_eq!(
+            reference.keys().collect::<Vec<_>>(),
+            got.keys().collect::<Vec<_>>()
+        );
+        for (file, bytes) in reference {
+            assert!(bytes == &got[file], "{file}: {first} and {name} differ");
+        }
+    }
+    let unknown = Command::new(env!("CARGO_BIN_EXE_lfgen"))
+        .args([
+            "--scenes",
+            "1",
+            "--out",
+            tmp().path().join("x").to_str().unwrap(),
+        ])
+        .args(TINY)
+        .env("LFGEN_SIMD", "avx512")
+        .output()
+        .expect("lfgen runs");
+    assert!(!unknown.status.success());
+    assert!(
+        stderr(&unknown).contains("LFGEN_SIMD"),
+        "{}",
+        stderr(&unknown)
+    );
+}
+
 /// The files of one scene generated with the defaults, with `args`, and with `args` on one
 /// thread (the others use every core).
 fn one_scene_without_and_with(args: &[&str]) -> [BTreeMap<String, Vec<u8>>; 3] {

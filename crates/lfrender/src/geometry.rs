@@ -1,17 +1,15 @@
-//! Triangles in an obvhs CWBVH and the three ray queries the renderer needs: closest hit with
-//! stochastic transparency, every hit along a ray (for the depth slices), and shadow
-//! transmittance.
+//! Triangles in a BVH (built by obvhs, traversed in the SIMD layout of [`super::wide`]) and the
+//! three ray queries the renderer needs: closest hit with stochastic transparency, every hit
+//! along a ray (for the depth slices), and shadow transmittance.
 
 use super::build_boxes::build_boxes;
 use super::material::RenderMaterial;
 use super::sampler::RayKey;
+use super::wide::{Kernel, WideBvh};
 use crate::scene::shapes::MeshTri;
 use anyhow::{Result, bail};
 use glam::{Vec2, Vec3, Vec3A};
-use obvhs::{
-    BvhBuildParams, cwbvh::CwBvh, cwbvh::builder::build_cwbvh, ray::Ray, ray::RayHit,
-    triangle::Triangle,
-};
+use obvhs::{BvhBuildParams, cwbvh::builder::build_cwbvh, triangle::Triangle};
 use std::time::Duration;
 
 /// Intersection data of one triangle, in BVH leaf order.
@@ -57,7 +55,7 @@ pub struct SceneTri {
 
 /// The scene's triangles and their BVH.
 pub struct Geometry {
-    bvh: CwBvh,
+    bvh: WideBvh,
     isect: Vec<IsectTri>,
     pub shading: Vec<TriShading>,
     /// Opacity per leaf when uniform over the triangle, NaN when it comes from a texture: the
@@ -94,7 +92,7 @@ impl Geometry {
             &mut Duration::default(),
         );
         let order = bvh.primitive_indices.iter().map(|&i| i as usize);
-        let isect = order
+        let isect: Vec<IsectTri> = order
             .clone()
             .map(|i| IsectTri {
                 v0: prims[i].v0,
@@ -125,8 +123,9 @@ impl Geometry {
                     .unwrap_or(f32::NAN)
             })
             .collect();
+        let edges: Vec<_> = isect.iter().map(|t| [t.v0, t.e1, t.e2]).collect();
         Ok(Self {
-            bvh,
+            bvh: WideBvh::new(&bvh, &edges, Kernel::from_env()?)?,
             isect,
             shading,
             leaf_opacity,
@@ -135,27 +134,6 @@ impl Geometry {
 
     pub fn triangle_count(&self) -> usize {
         self.isect.len()
-    }
-
-    /// Möller–Trumbore; returns `t` in `(tmin, tmax]` or `INFINITY`, and the barycentrics.
-    #[inline(always)]
-    fn intersect(&self, ray: &Ray, leaf: usize) -> (f32, Vec2) {
-        let tri = &self.isect[leaf];
-        let p = ray.direction.cross(tri.e2);
-        let det = tri.e1.dot(p);
-        if det.abs() < 1e-12 {
-            return (f32::INFINITY, Vec2::ZERO);
-        }
-        let inv = 1.0 / det;
-        let s = ray.origin - tri.v0;
-        let u = s.dot(p) * inv;
-        let q = s.cross(tri.e1);
-        let v = ray.direction.dot(q) * inv;
-        let t = tri.e2.dot(q) * inv;
-        if u < 0.0 || v < 0.0 || u + v > 1.0 || !(t > ray.tmin && t <= ray.tmax) {
-            return (f32::INFINITY, Vec2::ZERO);
-        }
-        (t, Vec2::new(u, v))
     }
 
     /// Interpolated UV of a hit.
@@ -259,45 +237,16 @@ impl Geometry {
         tmax: f32,
         accept: impl Fn(&Hit) -> bool,
     ) -> Option<Hit> {
-        let ray = Ray::new(origin.into(), dir.into(), tmin, tmax);
-        let mut best = Hit {
-            t: f32::INFINITY,
-            tri: 0,
-            b: Vec2::ZERO,
-        };
-        let mut rh = RayHit::none();
-        self.bvh.ray_traverse(ray, &mut rh, |r, leaf| {
-            let (t, b) = self.intersect(r, leaf);
-            if t < best.t {
-                let hit = Hit {
-                    t,
-                    tri: leaf as u32,
-                    b,
-                };
-                if accept(&hit) {
-                    best = hit;
-                    return t;
-                }
-            }
-            f32::INFINITY
-        });
-        (best.t < tmax).then_some(best)
+        (self.bvh).closest(origin.into(), dir.into(), tmin, tmax, accept)
     }
 
     /// Every surface along the ray up to `tmax`, sorted front to back, into `out` (cleared).
     /// Duplicate reports of one surface (shared edges, split leaves) are removed.
     pub fn all_hits(&self, origin: Vec3, dir: Vec3, tmax: f32, out: &mut Vec<Hit>) {
         out.clear();
-        let ray = Ray::new(origin.into(), dir.into(), 0.0, tmax);
-        self.bvh.ray_traverse_anyhit(ray, |r, leaf| {
-            let (t, b) = self.intersect(r, leaf);
-            if t.is_finite() {
-                out.push(Hit {
-                    t,
-                    tri: leaf as u32,
-                    b,
-                });
-            }
+        self.bvh.each_hit(origin.into(), dir.into(), tmax, |hit| {
+            out.push(*hit);
+            true
         });
         out.sort_unstable_by(|a, b| a.t.total_cmp(&b.t).then(a.tri.cmp(&b.tri)));
         out.dedup_by(|b, a| {
@@ -319,31 +268,23 @@ impl Geometry {
         tmax: f32,
         through_glass: bool,
     ) -> (Vec3, bool) {
-        let ray = Ray::new(origin.into(), dir.into(), 0.0, tmax);
         let (mut tr, mut crossed_glass) = (Vec3::ONE, false);
-        let clear = self.bvh.ray_traverse_miss(ray, |r, leaf| {
-            let (t, b) = self.intersect(r, leaf);
-            if t.is_finite() {
-                let hit = Hit {
-                    t,
-                    tri: leaf as u32,
-                    b,
-                };
-                let m = &mats[self.shading[leaf].material as usize];
-                crossed_glass |= m.glass_ior.is_some();
-                let passed = match m.glass_ior {
-                    Some(ior) if through_glass => self.glass_transmittance(m, &hit, dir, ior),
-                    Some(_) => Vec3::ZERO,
-                    None => Vec3::splat(1.0 - self.opacity(mats, &hit)),
-                };
-                if passed == Vec3::ZERO {
-                    return t;
-                }
-                tr *= passed;
+        self.bvh.each_hit(origin.into(), dir.into(), tmax, |hit| {
+            let m = &mats[self.shading[hit.tri as usize].material as usize];
+            crossed_glass |= m.glass_ior.is_some();
+            let passed = match m.glass_ior {
+                Some(ior) if through_glass => self.glass_transmittance(m, hit, dir, ior),
+                Some(_) => Vec3::ZERO,
+                None => Vec3::splat(1.0 - self.opacity(mats, hit)),
+            };
+            if passed == Vec3::ZERO {
+                tr = Vec3::ZERO;
+                return false;
             }
-            f32::INFINITY
+            tr *= passed;
+            true
         });
-        (if clear { tr } else { Vec3::ZERO }, crossed_glass)
+        (tr, crossed_glass)
     }
 
     /// What one glass interface passes of light crossing it along unit `dir`: its tint times

@@ -21,6 +21,7 @@ pub mod sensor;
 pub mod slices;
 pub mod valid;
 pub mod view;
+pub mod wide;
 
 use crate::scene::assets::Assets;
 use crate::scene::labels::SceneClasses;
