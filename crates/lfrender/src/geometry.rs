@@ -136,6 +136,11 @@ impl Geometry {
         self.isect.len()
     }
 
+    /// The kernel the BVH's queries run (the same bits whichever it is).
+    pub fn kernel(&self) -> Kernel {
+        self.bvh.kernel()
+    }
+
     /// Interpolated UV of a hit.
     #[inline]
     pub fn uv(&self, hit: &Hit) -> Vec2 {

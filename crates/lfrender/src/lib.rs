@@ -14,14 +14,17 @@ pub mod framing;
 pub mod geometry;
 pub mod integrator;
 pub mod light_field;
-pub mod lights;
-pub mod material;
+mod lights;
+mod material;
 pub mod sampler;
 pub mod sensor;
 pub mod slices;
-pub mod valid;
+mod valid;
 pub mod view;
-pub mod wide;
+mod wide;
+
+/// The BVH kernels (`LFGEN_SIMD` picks one): every kernel gives the same bits.
+pub use wide::Kernel;
 
 use crate::scene::assets::Assets;
 use crate::scene::labels::SceneClasses;
