@@ -7,10 +7,8 @@ use crate::config::{Config, ShadingMode};
 use crate::output::images::{ToneCurve, write_linear_exr, write_png};
 use crate::pipeline::{RenderJob, generate_scene};
 use crate::render::RenderScene;
-use crate::render::bsdf::{Frame, cosine_sample_hemisphere};
 use crate::render::framing::auto_exposure;
 use crate::render::integrator::Shading;
-use crate::render::sampler::{RayKey, Sampler};
 use crate::render::view::{Adaptive, RenderSettings};
 use anyhow::{Context, Result};
 use glam::Vec3;
@@ -58,7 +56,7 @@ pub fn speed(cfg: &Config) -> Result<Value> {
         "spp": cfg.render.spp,
         "kernel": format!("{:?}", scene.geometry.kernel()).to_lowercase(),
     });
-    traversal(&scene, &camera, &mut figures)?;
+    traversal(&scene, camera, &mut figures)?;
     let job = RenderJob::from_config(&cfg, "");
     let settings = job.render.view_settings(&desc);
     let counter = AtomicU64::new(0);
@@ -117,96 +115,60 @@ const REPS: u32 = 8;
 /// Mrays/s of each kind of query the renderer makes, into `figures`: closest hits and all
 /// hits (the ground truth's query) of the camera rays, the most coherent rays there are;
 /// closest hits of cosine-distributed rays from the camera rays' first surfaces (the path's
-/// incoherent bounces); and shadow rays from those surfaces to a sampled point on a light.
-fn traversal(scene: &RenderScene, camera: &[(Vec3, Vec3)], figures: &mut Value) -> Result<()> {
-    let geo = &scene.geometry;
-    let key = |k: u32| RayKey {
-        hash: u64::from(k),
-        phase: 0.0,
-    };
+/// incoherent bounces); and shadow rays from those surfaces to a sampled point on a light
+/// (the renderer's fixed probe rays, [`RenderScene::probe_rays`]).
+fn traversal(scene: &RenderScene, camera: Vec<(Vec3, Vec3)>, figures: &mut Value) -> Result<()> {
+    let probe = scene.probe_rays(camera);
     let closest = |rays: &[(Vec3, Vec3)]| {
         time(|| {
             rays.par_iter().for_each(|&(o, d)| {
                 for k in 0..REPS {
-                    black_box(geo.closest(&scene.materials, o, d, f32::INFINITY, key(k)));
+                    black_box(scene.probe_closest(o, d, k));
                 }
             })
         })
     };
-    let coherent = closest(camera);
+    let coherent = closest(&probe.camera);
     let all = time(|| {
-        camera.par_iter().for_each_init(Vec::new, |hits, &(o, d)| {
-            for _ in 0..REPS {
-                geo.all_hits(o, d, f32::INFINITY, hits);
-                black_box(hits.len());
-            }
-        })
+        probe
+            .camera
+            .par_iter()
+            .for_each_init(Vec::new, |hits, &(o, d)| {
+                for _ in 0..REPS {
+                    scene.geometry.all_hits(o, d, f32::INFINITY, hits);
+                    black_box(hits.len());
+                }
+            })
     });
-    let surfaces = first_surfaces(scene, camera);
-    let bounces: Vec<(Vec3, Vec3)> = surfaces
-        .iter()
-        .enumerate()
-        .map(|(i, &(p, n))| {
-            let u = sample(i, 0).next2();
-            (
-                p,
-                Frame::from_normal(n).to_world(cosine_sample_hemisphere(u)),
-            )
-        })
-        .collect();
-    let incoherent = closest(&bounces);
-    rate(
-        figures,
-        "closest_mrays_per_s",
-        "closest hit, camera rays (stochastic opacity)",
-        camera.len(),
-        coherent,
-    )?;
-    rate(
-        figures,
-        "all_hits_mrays_per_s",
-        "all hits, camera rays (anyhit + sort + dedupe)",
-        camera.len(),
-        all,
-    )?;
-    rate(
-        figures,
-        "incoherent_closest_mrays_per_s",
-        "closest hit, cosine bounces from the first surfaces",
-        bounces.len(),
-        incoherent,
-    )?;
+    let incoherent = closest(&probe.bounces);
+    let rays = probe.camera.len();
+    let label = "closest hit, camera rays (stochastic opacity)";
+    rate(figures, "closest_mrays_per_s", label, rays, coherent)?;
+    let label = "all hits, camera rays (anyhit + sort + dedupe)";
+    rate(figures, "all_hits_mrays_per_s", label, rays, all)?;
+    let label = "closest hit, cosine bounces from the first surfaces";
+    let (name, bounces) = ("incoherent_closest_mrays_per_s", probe.bounces.len());
+    rate(figures, name, label, bounces, incoherent)?;
     figures["all_hits_cost_ratio"] = json!(all / coherent);
     lfformat::say!("all_hits_cost_ratio: {:.3}", all / coherent)?;
-    if scene.lights.is_empty() {
+    if probe.shadows.is_empty() {
         return Ok(lfformat::say!(
             "shadow rays: the scene has no emissive surface to aim at"
         )?);
     }
-    let shadows: Vec<(Vec3, Vec3, f32)> = surfaces
-        .iter()
-        .enumerate()
-        .map(|(i, &(p, _))| {
-            let mut s = sample(i, 1);
-            let light = scene
-                .lights
-                .sample(geo, &scene.materials, p, s.next_f32(), s.next2());
-            let to = light.p - p;
-            (p, to.normalize(), to.length() * (1.0 - 1e-4))
-        })
-        .collect();
     let shadow = time(|| {
-        shadows.par_iter().for_each(|&(o, d, t)| {
+        probe.shadows.par_iter().for_each(|&(o, d, t)| {
             for _ in 0..REPS {
-                black_box(geo.transmittance(&scene.materials, o, d, t, false));
+                black_box(scene.probe_shadow(o, d, t));
             }
         })
     });
+    let label = "shadow rays to a light sample (any hit, early exit)";
     rate(
         figures,
         "shadow_mrays_per_s",
-        "shadow rays to a light sample (any hit, early exit)",
-        shadows.len(),
+        label,
+        probe.shadows.len(),
         shadow,
     )
 }
@@ -217,37 +179,6 @@ fn rate(figures: &mut Value, name: &str, label: &str, rays: usize, seconds: f64)
     figures[name] = json!(mrays);
     Ok(lfformat::say!("{label}: {mrays:.2} Mrays/s")?)
 }
-
-/// Where the camera rays first meet an opaque-enough surface, each lifted off it along its
-/// normal turned towards the camera: the origins of the secondary queries.
-fn first_surfaces(scene: &RenderScene, camera: &[(Vec3, Vec3)]) -> Vec<(Vec3, Vec3)> {
-    let geo = &scene.geometry;
-    let key = RayKey {
-        hash: 0,
-        phase: 0.0,
-    };
-    camera
-        .iter()
-        .filter_map(|&(o, d)| {
-            let hit = geo.closest(&scene.materials, o, d, f32::INFINITY, key)?;
-            let n = geo.geometric_normal(hit.tri);
-            let n = if n.dot(d) > 0.0 { -n } else { n };
-            let p = o + d * hit.t;
-            Some((p + n * 1e-4 * p.abs().max_element().max(1.0), n))
-        })
-        .collect()
-}
-
-/// The bench's random numbers for surface `i`, stream `stream`: fixed, so every run and
-/// binary traces the same rays.
-fn sample(i: usize, stream: u32) -> Sampler {
-    let mut s = Sampler::new(BENCH_SEED, 0, stream, i as u32, 0, 1);
-    s.start_sample(0);
-    s
-}
-
-/// Seed of [`sample`].
-const BENCH_SEED: u64 = 0xBE7C;
 
 fn time(f: impl FnOnce()) -> f64 {
     let t = Instant::now();

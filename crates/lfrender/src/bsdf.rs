@@ -252,12 +252,12 @@ impl Frame {
     }
 
     /// World-space vector to local coordinates (`z` along the normal).
-    pub fn to_local(&self, v: Vec3) -> Vec3 {
+    pub fn to_local(self, v: Vec3) -> Vec3 {
         Vec3::new(v.dot(self.t), v.dot(self.b), v.dot(self.n))
     }
 
     /// Local coordinates back to world space.
-    pub fn to_world(&self, v: Vec3) -> Vec3 {
+    pub fn to_world(self, v: Vec3) -> Vec3 {
         self.t * v.x + self.b * v.y + self.n * v.z
     }
 }

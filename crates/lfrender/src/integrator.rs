@@ -536,14 +536,14 @@ impl RenderScene {
                 let last = depth + settings.max_depth - path.first_depth;
                 path.later.open(cells, path.direct, last);
             }
-            let scattered = Scatter {
+            let continuation = Scatter {
                 settings,
                 start: &start,
                 shading,
                 plan: &plan,
                 depth,
             };
-            let Some(next) = self.scatter(&scattered, &vertex, sampler, &mut path) else {
+            let Some(next) = self.scatter(&continuation, &vertex, sampler, &mut path) else {
                 break;
             };
             (origin, dir) = next;

@@ -7,7 +7,7 @@
 // renderer reads like the rest of lfgen; private, so they are not re-exported from here.
 use lfscene::{camera, scene, textures, util};
 
-pub mod bsdf;
+mod bsdf;
 mod build_boxes;
 pub mod cache;
 pub mod framing;
@@ -16,7 +16,8 @@ pub mod integrator;
 pub mod light_field;
 mod lights;
 mod material;
-pub mod sampler;
+pub mod probe;
+mod sampler;
 pub mod sensor;
 pub mod slices;
 mod valid;
