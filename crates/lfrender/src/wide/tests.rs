@@ -225,3 +225,44 @@ fn unknown_or_unsupported_kernels_are_refused_by_name() {
         *Kernel::available().last().unwrap()
     );
 }
+
+/// 50 000 copies of one triangle (an OBJ that repeats a face; `build_boxes` spreads their
+/// boxes for the builder) and 20 000 slivers along one line: the tree stays within the walk's
+/// fixed stack, and a ray through them finds the lowest-index copy first.
+#[test]
+fn degenerate_soups_stay_within_the_stack() {
+    let t = Triangle {
+        v0: Vec3A::new(-1.0, -1.0, 0.0),
+        v1: Vec3A::new(1.0, -1.0, 0.0),
+        v2: Vec3A::new(0.0, 1.0, 0.0),
+    };
+    let mut tris = vec![t; 50_000];
+    tris.extend((0..20_000).map(|i| {
+        let x = i as f32 * 1e-3;
+        Triangle {
+            v0: Vec3A::new(x, 2.0, 0.0),
+            v1: Vec3A::new(x + 1e-3, 2.0, 0.0),
+            v2: Vec3A::new(x + 5e-4, 2.0, 1e-6),
+        }
+    }));
+    let boxes = crate::build_boxes::build_boxes(&tris);
+    let cw = obvhs::cwbvh::builder::build_cwbvh(
+        &boxes,
+        BvhBuildParams::medium_build(),
+        &mut Duration::default(),
+    );
+    let leaf: Vec<[Vec3A; 3]> = (cw.primitive_indices.iter())
+        .map(|&i| tris[i as usize])
+        .map(|t| [t.v0, t.v1 - t.v0, t.v2 - t.v0])
+        .collect();
+    for kernel in Kernel::available() {
+        let bvh = WideBvh::new(&cw, &leaf, kernel).unwrap();
+        let (o, d) = (Vec3A::new(0.1, 0.0, 1.0), Vec3A::new(0.0, 0.0, -1.0));
+        let hit = bvh.closest(o, d, 0.0, f32::INFINITY, |_| true).unwrap();
+        let lowest = (leaf.iter().enumerate())
+            .filter_map(|(i, &tri)| reference(o, d, tri, 0.0, f32::INFINITY).map(|_| i as u32))
+            .min()
+            .unwrap();
+        assert_eq!((hit.t, hit.tri), (1.0, lowest), "{kernel:?}");
+    }
+}
