@@ -245,7 +245,7 @@ fn degenerate_soups_stay_within_the_stack() {
             v2: Vec3A::new(x + 5e-4, 2.0, 1e-6),
         }
     }));
-    let boxes = crate::build_boxes::build_boxes(&tris);
+    let boxes = super::super::build_boxes::build_boxes(&tris);
     let cw = obvhs::cwbvh::builder::build_cwbvh(
         &boxes,
         BvhBuildParams::medium_build(),
