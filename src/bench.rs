@@ -30,14 +30,14 @@ pub fn speed(cfg: &Config) -> Result<Value> {
     let (desc, scene) = generate_scene(&cfg, 0, None)?;
     let cam = &desc.camera;
     lfformat::say!(
-        "scene: {} triangles, {} threads, {}x{} px, {} spp, max depth {}, {:?} BVH kernel",
+        "scene: {} triangles, {} threads, {}x{} px, {} spp, max depth {}, {} BVH kernel",
         scene.geometry.triangle_count(),
         rayon::current_num_threads(),
         BENCH_RES,
         BENCH_RES,
         cfg.render.spp,
         cfg.render.max_depth,
-        scene.geometry.kernel()
+        scene.geometry.kernel().name()
     )?;
     let rays = cam.view_rays(cam.center_view());
     let pixels: Vec<(u32, u32)> = (0..BENCH_RES)
@@ -54,7 +54,7 @@ pub fn speed(cfg: &Config) -> Result<Value> {
         "threads": rayon::current_num_threads(),
         "size": BENCH_RES,
         "spp": cfg.render.spp,
-        "kernel": format!("{:?}", scene.geometry.kernel()).to_lowercase(),
+        "kernel": scene.geometry.kernel().name(),
     });
     traversal(&scene, camera, &mut figures)?;
     let job = RenderJob::from_config(&cfg, "");

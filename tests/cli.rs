@@ -47,20 +47,12 @@ fn every_simd_kernel_renders_the_same_bytes() {
     let kernels = lfgen::render::Kernel::available();
     #[cfg(target_arch = "x86_64")]
     assert!(kernels.len() >= 2, "x86-64 always has SSE: {kernels:?}");
-    let runs: Vec<(String, BTreeMap<String, Vec<u8>>)> = kernels
+    let runs: Vec<(&str, BTreeMap<String, Vec<u8>>)> = kernels
         .iter()
         .map(|k| {
-            let name = format!("{k:?}").to_lowercase();
             let dir = tmp();
-            let mut args = vec!["--scenes", "2", "--out", dir.path().to_str().unwrap()];
-            args.extend_from_slice(TINY);
-            let out = Command::new(env!("CARGO_BIN_EXE_lfgen"))
-                .args(&args)
-                .env("LFGEN_SIMD", &name)
-                .output()
-                .expect("lfgen runs");
-            ok(out);
-            (name, files(dir.path()))
+            ok(generate_simd(k.name(), dir.path(), "2"));
+            (k.name(), files(dir.path()))
         })
         .collect();
     let (first, reference) = &runs[0];
@@ -73,23 +65,19 @@ fn every_simd_kernel_renders_the_same_bytes() {
             assert!(bytes == &got[file], "{file}: {first} and {name} differ");
         }
     }
-    let unknown = Command::new(env!("CARGO_BIN_EXE_lfgen"))
-        .args([
-            "--scenes",
-            "1",
-            "--out",
-            tmp().path().join("x").to_str().unwrap(),
-        ])
-        .args(TINY)
-        .env("LFGEN_SIMD", "avx512")
-        .output()
-        .expect("lfgen runs");
+    let unknown = generate_simd("avx512", &tmp().path().join("x"), "1");
     assert!(!unknown.status.success());
     assert!(
         stderr(&unknown).contains("LFGEN_SIMD"),
         "{}",
         stderr(&unknown)
     );
+}
+
+/// [`generate`] with the BVH's SIMD kernel forced to `kernel`.
+fn generate_simd(kernel: &str, out: &Path, scenes: &str) -> Output {
+    let args = ["--scenes", scenes, "--out", out.to_str().unwrap()];
+    bin::lfgen_simd(kernel, &[&args[..], TINY].concat())
 }
 
 /// The files of one scene generated with the defaults, with `args`, and with `args` on one
@@ -572,17 +560,14 @@ fn the_speed_bench_records_every_query_kind() {
     // this CPU has (SSE on an AVX2 machine), so it is not the one chosen anyway.
     let all = lfgen::render::Kernel::available();
     let kernel = all[all.len().saturating_sub(2)];
-    let name = format!("{kernel:?}").to_lowercase();
-    let out = Command::new(env!("CARGO_BIN_EXE_lfgen"))
-        .args(["bench", "speed"])
-        .args(extra)
-        .env("LFGEN_SIMD", &name)
-        .output()
-        .expect("lfgen runs");
-    ok(out);
+    let name = kernel.name();
+    ok(bin::lfgen_simd(
+        name,
+        &[&["bench", "speed"][..], &extra].concat(),
+    ));
     let record = only_record(&results);
     let figures = &record["figures"];
-    assert_eq!(figures["kernel"], name.as_str(), "{record}");
+    assert_eq!(figures["kernel"], name, "{record}");
     for key in [
         "closest_mrays_per_s",
         "all_hits_mrays_per_s",

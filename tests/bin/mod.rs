@@ -17,6 +17,15 @@ pub fn lfgen(args: &[&str]) -> Output {
         .expect("lfgen runs")
 }
 
+/// Runs `lfgen` with `args`, its BVH traced by the SIMD kernel `kernel` (`LFGEN_SIMD`).
+pub fn lfgen_simd(kernel: &str, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_lfgen"))
+        .args(args)
+        .env("LFGEN_SIMD", kernel)
+        .output()
+        .expect("lfgen runs")
+}
+
 /// Asserts the run succeeded, showing its stderr otherwise.
 pub fn ok(out: Output) -> Output {
     assert!(out.status.success(), "lfgen failed: {}", stderr(&out));

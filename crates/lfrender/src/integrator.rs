@@ -416,7 +416,8 @@ enum First {
 /// What a path's continuation needs besides the vertex.
 struct Scatter<'a> {
     settings: &'a PathSettings,
-    start: &'a Start,
+    /// Smooth glass on the camera ray is split into its two branches ([`Start::split`]).
+    split: bool,
     shading: Shading<'a>,
     plan: &'a Plan,
     depth: u32,
@@ -538,7 +539,7 @@ impl RenderScene {
             }
             let continuation = Scatter {
                 settings,
-                start: &start,
+                split: start.split,
                 shading,
                 plan: &plan,
                 depth,
@@ -710,7 +711,7 @@ impl RenderScene {
         }
         // Glass on the camera ray is split: the path always refracts, and the reflection is
         // traced as a branch of its own (see [`Self::reflection`]).
-        let split = s.start.split && bsdf.is_delta() && path.camera_length.is_some();
+        let split = s.split && bsdf.is_delta() && path.camera_length.is_some();
         let u_lobe = sampler.next_f32();
         let u_lobe = if split { 1.0 } else { u_lobe };
         let bs = bsdf.sample_lobes(wo_l, u_lobe, sampler.next2(), plan.lobes)?;

@@ -104,6 +104,17 @@ impl Kernel {
         }
     }
 
+    /// The kernel's name, as `LFGEN_SIMD` and [`Self::named`] take it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Scalar => "scalar",
+            #[cfg(target_arch = "x86_64")]
+            Self::Sse => "sse",
+            #[cfg(target_arch = "x86_64")]
+            Self::Avx2 => "avx2",
+        }
+    }
+
     /// Every kernel this CPU runs, slowest first.
     pub fn available() -> Vec<Self> {
         let mut all = vec![Self::Scalar];

@@ -2,7 +2,7 @@
 
 use super::*;
 use glam::Vec2;
-use obvhs::{BvhBuildParams, cwbvh::builder::build_cwbvh_from_tris, triangle::Triangle};
+use obvhs::{BvhBuildParams, cwbvh::builder::build_cwbvh, triangle::Triangle};
 use std::time::Duration;
 
 /// xorshift32: a fixed stream of test numbers without a dependency.
@@ -128,11 +128,12 @@ fn brute(tris: &[[Vec3A; 3]], o: Vec3A, d: Vec3A, tmin: f32, tmax: f32) -> Vec<H
     hits
 }
 
-/// The soup's tree in each kernel, and its triangles (`v0, e1, e2`) in leaf order.
-fn trees() -> (Vec<WideBvh>, Vec<[Vec3A; 3]>) {
-    let tris = soup();
-    let cw = build_cwbvh_from_tris(
-        &tris,
+/// The tree of `tris` in each kernel, built as the renderer builds it (obvhs over
+/// `build_boxes`), and its triangles (`v0, e1, e2`) in leaf order.
+fn trees_of(tris: &[Triangle]) -> (Vec<WideBvh>, Vec<[Vec3A; 3]>) {
+    let boxes = super::super::build_boxes::build_boxes(tris);
+    let cw = build_cwbvh(
+        &boxes,
         BvhBuildParams::medium_build(),
         &mut Duration::default(),
     );
@@ -140,12 +141,15 @@ fn trees() -> (Vec<WideBvh>, Vec<[Vec3A; 3]>) {
         .map(|&i| tris[i as usize])
         .map(|t| [t.v0, t.v1 - t.v0, t.v2 - t.v0])
         .collect();
-    let kernels = Kernel::available();
-    let trees = kernels
-        .iter()
-        .map(|&k| WideBvh::new(&cw, &leaf, k).unwrap())
+    let trees = (Kernel::available().into_iter())
+        .map(|k| WideBvh::new(&cw, &leaf, k).unwrap())
         .collect();
     (trees, leaf)
+}
+
+/// The soup's trees ([`trees_of`]).
+fn trees() -> (Vec<WideBvh>, Vec<[Vec3A; 3]>) {
+    trees_of(&soup())
 }
 
 /// Bits of a hit list, for exact comparison (`==` on floats would equate 0.0 and -0.0).
@@ -245,24 +249,14 @@ fn degenerate_soups_stay_within_the_stack() {
             v2: Vec3A::new(x + 5e-4, 2.0, 1e-6),
         }
     }));
-    let boxes = super::super::build_boxes::build_boxes(&tris);
-    let cw = obvhs::cwbvh::builder::build_cwbvh(
-        &boxes,
-        BvhBuildParams::medium_build(),
-        &mut Duration::default(),
-    );
-    let leaf: Vec<[Vec3A; 3]> = (cw.primitive_indices.iter())
-        .map(|&i| tris[i as usize])
-        .map(|t| [t.v0, t.v1 - t.v0, t.v2 - t.v0])
-        .collect();
-    for kernel in Kernel::available() {
-        let bvh = WideBvh::new(&cw, &leaf, kernel).unwrap();
+    let (trees, leaf) = trees_of(&tris);
+    for bvh in &trees {
         let (o, d) = (Vec3A::new(0.1, 0.0, 1.0), Vec3A::new(0.0, 0.0, -1.0));
         let hit = bvh.closest(o, d, 0.0, f32::INFINITY, |_| true).unwrap();
         let lowest = (leaf.iter().enumerate())
             .filter_map(|(i, &tri)| reference(o, d, tri, 0.0, f32::INFINITY).map(|_| i as u32))
             .min()
             .unwrap();
-        assert_eq!((hit.t, hit.tri), (1.0, lowest), "{kernel:?}");
+        assert_eq!((hit.t, hit.tri), (1.0, lowest), "{:?}", bvh.kernel());
     }
 }
