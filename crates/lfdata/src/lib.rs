@@ -3,7 +3,8 @@
 //!
 //! Layout: [`lightfield`] the views in memory (loading, crop, rotation), [`stacks`] the view
 //! stacks through the centre view and the bilinear EPI shift, [`cost`] the plane-sweep cost
-//! (the classical baseline's volume and a stack's network input); [`bins`] and [`laplace`] the
+//! (the classical baseline's volume and a stack's network input), [`denoise`] the test-time
+//! cross-view denoising; [`bins`] and [`laplace`] the
 //! discretisation maths, [`posterior`] the predicted distributions, [`prediction`] (with
 //! [`npz`]) the prediction files, [`truth`] the ground truth (modes, front-most mode, masks);
 //! [`metrics`] the pure metric functions and [`scene_eval`] every metric of one method on one
@@ -14,6 +15,7 @@
 pub mod bins;
 pub mod camera;
 pub mod cost;
+pub mod denoise;
 pub mod font;
 pub mod laplace;
 pub mod lightfield;

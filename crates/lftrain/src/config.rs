@@ -632,6 +632,12 @@ pub struct TrainConfig {
     /// `augment.rotate` has seen every turn, so each is an equally good estimate whose
     /// errors are partly independent. `lftrain predict --rotations` overrides it.
     pub test_rotations: usize,
+    /// Test-time denoising (not in the thesis; `lfdata::denoise`): `lftrain predict` predicts
+    /// once, averages each view with its 3 × 3 angular neighbours warped by that prediction
+    /// (each weighted by its agreement, within this many times the noise the views show between
+    /// them), and predicts again. Views without noise between them pass unchanged, so clean
+    /// scenes cost only the second pass. 0: off. `lftrain predict --denoise` overrides it.
+    pub test_denoise: f32,
 }
 
 impl Default for TrainConfig {
@@ -666,6 +672,7 @@ impl Default for TrainConfig {
             dpp: DppConfig::default(),
             epishift: EpiShiftConfig::default(),
             test_rotations: 1,
+            test_denoise: 0.0,
         }
     }
 }
@@ -745,6 +752,12 @@ impl TrainConfig {
         }
         if self.model == ModelKind::EpiShift && self.test_rotations != 1 {
             bail!("test_rotations applies to base, upr, ese and dpp; epishift takes 1");
+        }
+        if !(self.test_denoise >= 0.0 && self.test_denoise.is_finite()) {
+            bail!(
+                "test_denoise must be 0 (off) or a finite width in units of the noise, got {}",
+                self.test_denoise
+            );
         }
         if self.ese.members == 0 || self.ese.members.is_multiple_of(2) || self.ese.delta <= 0.0 {
             bail!("ese.members must be odd and ese.delta positive");
@@ -963,8 +976,8 @@ mod tests {
 
     /// The cost recipe: the per-hypothesis net on 60 hypotheses over ±4.5 px, radius 4 px
     /// (the baseline's 9×9 window), no EPI shift (the targets must stay inside the
-    /// hypotheses), sensor-noise augmentation, the field recipe's schedule scaled to 1 000
-    /// steps.
+    /// hypotheses), sensor-noise augmentation and test-time denoising, the field recipe's
+    /// schedule scaled to 1 000 steps.
     #[test]
     fn the_cost_recipe_reads_cost_volumes_and_refuses_epishift() {
         let cost: TrainConfig = toml::from_str(include_str!("../configs/cpu_cost.toml")).unwrap();
@@ -978,6 +991,7 @@ mod tests {
             [0.0, 0.03],
             "chosen by the robustness benchmark"
         );
+        assert_eq!(cost.test_denoise, 2.0, "chosen by the robustness benchmark");
         assert_eq!(cost.net.receptive_radius(), 4);
         assert_eq!(
             (
@@ -1128,10 +1142,6 @@ mod tests {
 
     #[test]
     fn huge_batches_and_patches_are_refused_before_they_allocate() {
-        let with = |text: &str| {
-            let cfg: TrainConfig = toml::from_str(text).unwrap();
-            cfg.validate().map_err(|e| e.to_string())
-        };
         assert!(with("batch = 512\npatch = 96").is_ok());
         assert!(with("batch = 1000000000").unwrap_err().contains("batch"));
         assert!(with("patch = 100000").unwrap_err().contains("patch"));
@@ -1142,12 +1152,14 @@ mod tests {
         );
     }
 
+    /// The validation error of the config `text` (TOML), if any.
+    fn with(text: &str) -> Result<(), String> {
+        let cfg: TrainConfig = toml::from_str(text).unwrap();
+        cfg.validate().map_err(|e| e.to_string())
+    }
+
     #[test]
     fn test_rotations_are_one_to_four_turns_and_not_for_epishift() {
-        let with = |text: &str| {
-            let cfg: TrainConfig = toml::from_str(text).unwrap();
-            cfg.validate().map_err(|e| e.to_string())
-        };
         assert_eq!(TrainConfig::default().test_rotations, 1);
         assert!(with("test_rotations = 4\nmodel = \"dpp\"").is_ok());
         assert!(
@@ -1161,11 +1173,23 @@ mod tests {
     }
 
     #[test]
+    fn test_denoise_is_off_or_a_finite_width() {
+        assert_eq!(TrainConfig::default().test_denoise, 0.0);
+        assert!(with("test_denoise = 2.0").is_ok());
+        assert!(
+            with("test_denoise = -1.0")
+                .unwrap_err()
+                .contains("test_denoise")
+        );
+        assert!(
+            with("test_denoise = inf")
+                .unwrap_err()
+                .contains("test_denoise")
+        );
+    }
+
+    #[test]
     fn the_dpp_mode_window_must_fit_in_the_bins() {
-        let with = |text: &str| {
-            let cfg: TrainConfig = toml::from_str(text).unwrap();
-            cfg.validate().map_err(|e| e.to_string())
-        };
         assert_eq!(TrainConfig::default().dpp.mode_window, 0);
         assert!(with("[dpp]\nmode_window = 53").is_ok());
         assert!(

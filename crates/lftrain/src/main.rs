@@ -80,6 +80,11 @@ enum Command {
         /// dpp.mode_window; 0: the most probable bin, as the thesis).
         #[arg(long, value_name = "R")]
         mode_window: Option<usize>,
+        /// Predict, denoise every view through that prediction with its 3x3 angular neighbours
+        /// (weights within K times the noise measured between the views), predict again
+        /// (overrides the run's test_denoise; 0: off).
+        #[arg(long, value_name = "K")]
+        denoise: Option<f32>,
     },
     /// Seconds per training step of a configuration on random input (no data loading), or
     /// with --loader the crops/s of the data loader alone.
@@ -281,12 +286,14 @@ fn run(cli: Cli) -> Result<()> {
             coarse_max,
             rotations,
             mode_window,
+            denoise,
         } => {
             let overrides = Overrides {
                 range,
                 coarse_max,
                 rotations,
                 mode_window,
+                denoise,
             };
             let n = predict_dataset_over(&run, &dataset, &out, cli.workers.quiet, &overrides)?;
             lfformat::note!("lftrain: {n} scenes written to {}", out.display());

@@ -11,6 +11,7 @@ use lfdata::prediction::ScenePrediction;
 use lfdata::stacks::{Direction, Region};
 use lfdata::{Bins, laplace};
 use lfformat::pfm::FloatImage;
+use lfformat::views::ViewSet;
 
 use crate::config::{EsePoint, ModelKind, NetInput, TrainConfig};
 use crate::epishift::EpiShiftNet;
@@ -77,8 +78,29 @@ fn turn_plane(plane: Vec<f32>, w: usize, h: usize, turns: usize) -> Vec<f32> {
         .0
 }
 
-/// The prediction of `net` (trained as `cfg.model`) for `lf`, with its runtime.
+/// The prediction of `net` (trained as `cfg.model`) for `lf`, with its runtime; with
+/// [`TrainConfig::test_denoise`] on, predicted again on `lf` denoised through the first
+/// prediction (the denoising reads every loaded view: load them all, not only the star).
 pub fn predict(
+    cfg: &TrainConfig,
+    net: &Network,
+    lf: &LightField,
+    device: &Device,
+) -> ScenePrediction {
+    let first = predict_pass(cfg, net, lf, device);
+    if cfg.test_denoise == 0.0 {
+        return first;
+    }
+    let start = Instant::now();
+    let denoised = lfdata::denoise::denoise(lf, &first.disparity.data, cfg.test_denoise);
+    let spent = start.elapsed().as_secs_f64() + first.runtime_s.unwrap_or(0.0);
+    let mut second = predict_pass(cfg, net, &denoised, device);
+    second.runtime_s = second.runtime_s.map(|s| s + spent);
+    second
+}
+
+/// One prediction of `net` for `lf`, without test-time denoising (see [`predict`]).
+pub fn predict_pass(
     cfg: &TrainConfig,
     net: &Network,
     lf: &LightField,
@@ -309,6 +331,8 @@ pub struct Overrides {
     pub rotations: Option<usize>,
     /// `--mode-window`: [`crate::config::DppConfig::mode_window`].
     pub mode_window: Option<usize>,
+    /// `--denoise`: [`TrainConfig::test_denoise`].
+    pub denoise: Option<f32>,
 }
 
 impl Overrides {
@@ -344,6 +368,10 @@ impl Overrides {
         if let Some(k) = self.rotations {
             cfg.test_rotations = k;
             given.push(format!("--rotations {k}"));
+        }
+        if let Some(k) = self.denoise {
+            cfg.test_denoise = k;
+            given.push(format!("--denoise {k}"));
         }
         if let Some(r) = self.mode_window {
             only("--mode-window", &[Dpp])?;
@@ -411,14 +439,18 @@ pub fn predict_dataset_over(
     let bar = lfdata::progress::progress(scenes.len(), "predicting", quiet);
     let mut ranges = Vec::new();
     for s in &scenes {
-        let lf = LightField::load_star(&s.path)?;
+        let lf = if cfg.test_denoise > 0.0 {
+            LightField::load(&s.path, ViewSet::Full)?
+        } else {
+            LightField::load_star(&s.path)?
+        };
         ranges.extend(lf.disparity_range.map(|r| (s.name.clone(), r)));
-        if lf.nx != state.grid {
+        if (lf.nx, lf.ny) != (state.grid, state.grid) {
             anyhow::bail!(
                 "{}: {}x{} views, the network was trained on {}x{}",
                 s.path.display(),
                 lf.nx,
-                lf.nx,
+                lf.ny,
                 state.grid,
                 state.grid
             );

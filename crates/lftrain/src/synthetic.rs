@@ -159,22 +159,20 @@ impl TwoPlanes {
         FloatImage::new(self.size, self.size, data)
     }
 
-    /// Writes an lfgen-style scene folder: `parameters.cfg`, the star views as 8-bit PNGs,
-    /// `gt_disp_lowres.pfm` and, with `multimodal`, `modes.exr`.
+    /// Writes an lfgen-style scene folder: `parameters.cfg`, every view as an 8-bit PNG (as
+    /// lfgen and HCI write them; test-time denoising reads them all), `gt_disp_lowres.pfm`
+    /// and, with `multimodal`, `modes.exr`.
     pub fn write(&self, dir: &Path, multimodal: bool) -> Result<()> {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("{}: cannot create", dir.display()))?;
         let (lo, hi) = (self.back.min(self.front), self.back.max(self.front));
         parameters(self.n, self.size, [lo, hi]).write(&dir.join("parameters.cfg"))?;
-        let lf = self.render();
-        for (i, view) in lf.views.iter().enumerate() {
-            let Some(rgb) = view else { continue };
-            let bytes = rgb
-                .iter()
-                .map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8)
-                .collect();
-            let img = image::RgbImage::from_raw(self.size as u32, self.size as u32, bytes)
-                .context("view buffer size")?;
+        for i in 0..self.n * self.n {
+            let (u, v) = (i % self.n, i / self.n);
+            let img = image::RgbImage::from_fn(self.size as u32, self.size as u32, |x, y| {
+                let rgb = self.colour(u, v, x as usize, y as usize);
+                image::Rgb(rgb.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8))
+            });
             let path = dir.join(format!("input_Cam{i:03}.png"));
             img.save(&path)
                 .with_context(|| format!("{}: cannot write", path.display()))?;

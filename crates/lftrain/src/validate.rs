@@ -14,7 +14,7 @@ use serde::Serialize;
 
 use crate::config::TrainConfig;
 use crate::model::Network;
-use crate::predict::predict;
+use crate::predict::predict_pass;
 
 /// A validation scene, loaded once.
 pub struct ValScene {
@@ -69,7 +69,9 @@ pub fn validate(
     let mut kld = KldSums::default();
     let mut front = Vec::new();
     for s in scenes {
-        let pred = predict(cfg, net, &s.lf, device);
+        // One pass: validation tracks the network; the views it holds are the star only, and
+        // test-time denoising is `lftrain predict`'s, over every view.
+        let pred = predict_pass(cfg, net, &s.lf, device);
         let scores = evaluate(&PreparedTruth::new(&s.truth, &ecfg), &pred, &ecfg);
         kld.merge(&scores.kld);
         front.push(scores.against(Reference::Front));
