@@ -79,8 +79,8 @@ fn turn_plane(plane: Vec<f32>, w: usize, h: usize, turns: usize) -> Vec<f32> {
 }
 
 /// The prediction of `net` (trained as `cfg.model`) for `lf`, with its runtime; with
-/// [`TrainConfig::test_denoise`] on, predicted again on `lf` denoised through the first
-/// prediction (the denoising reads every loaded view: load them all, not only the star).
+/// [`TrainConfig::test_denoise`] on, predicted again on the star's views of `lf` denoised
+/// through the first prediction (the denoising reads every loaded view: load them all).
 pub fn predict(
     cfg: &TrainConfig,
     net: &Network,
@@ -92,7 +92,8 @@ pub fn predict(
         return first;
     }
     let start = Instant::now();
-    let denoised = lfdata::denoise::denoise(lf, &first.disparity.data, cfg.test_denoise);
+    let denoised =
+        lfdata::denoise::denoise(lf, &first.disparity.data, cfg.test_denoise, ViewSet::Star);
     let spent = start.elapsed().as_secs_f64() + first.runtime_s.unwrap_or(0.0);
     let mut second = predict_pass(cfg, net, &denoised, device);
     second.runtime_s = second.runtime_s.map(|s| s + spent);
