@@ -40,6 +40,9 @@ pub fn view_noise(lf: &LightField, disparity: &[f32]) -> f32 {
         for y in by..h - by {
             for x in bx..w - bx {
                 let d = disparity[y * w + x];
+                if !d.is_finite() {
+                    continue;
+                }
                 let s = bilinear(b, w, h, x as f32 - d, y as f32);
                 let own = &a[3 * (y * w + x)..][..3];
                 diffs.extend((0..3).map(|c| (own[c] - s[c]).abs()));
@@ -106,6 +109,11 @@ fn filter_view(
         for x in 0..w {
             let d = disparity[y * w + x];
             let centre = &own[3 * (y * w + x)..][..3];
+            if !d.is_finite() {
+                // No estimate to align the neighbours by: the pixel keeps its colour.
+                out.extend_from_slice(centre);
+                continue;
+            }
             let (mut sum, mut weight) = ([centre[0], centre[1], centre[2]], 1.0);
             for &(du, dv, view) in &neighbours {
                 let s = bilinear(view, w, h, x as f32 - du * d, y as f32 - dv * d);
@@ -253,6 +261,26 @@ mod tests {
         let (still, _) = plane(1.0, 0.0);
         assert_eq!(denoise(&still, &truth, 2.0, ViewSet::Full), still);
         assert_eq!(denoise(&noisy, &truth, 0.0, ViewSet::Full), noisy);
+    }
+
+    /// A pixel without a first estimate (NaN) keeps its colour, and the estimate of the noise
+    /// ignores it.
+    #[test]
+    fn pixels_without_an_estimate_keep_their_colour() {
+        let (noisy, _) = plane(1.0, 0.02);
+        let mut map = vec![1.0; SIDE * SIDE];
+        map[20 * SIDE + 21] = f32::NAN;
+        let out = denoise(&noisy, &map, 2.0, ViewSet::Full);
+        let c = N / 2;
+        let pixel = |lf: &LightField| lf.view(c, c)[3 * (20 * SIDE + 21)..][..3].to_vec();
+        assert_eq!(pixel(&out), pixel(&noisy));
+        assert!(out.loaded().all(|(_, v)| v.iter().all(|p| p.is_finite())));
+        let with = view_noise(&noisy, &map);
+        let without = view_noise(&noisy, &[1.0; SIDE * SIDE]);
+        assert!(
+            with.is_finite() && (with / without - 1.0).abs() < 0.01,
+            "{with} {without}"
+        );
     }
 
     /// Where the disparity is wrong (a patch of the map) the neighbours disagree with the pixel
