@@ -604,5 +604,12 @@ mod tests {
             ..Default::default()
         };
         assert!(err(turns, ModelKind::Base).starts_with("--rotations 5"));
+        let denoise = |k| Overrides {
+            denoise: Some(k),
+            ..Default::default()
+        };
+        let on = denoise(2.0).apply(cfg(ModelKind::EpiShift)).unwrap();
+        assert_eq!(on.test_denoise, 2.0, "every model takes it");
+        assert!(err(denoise(-1.0), ModelKind::Base).starts_with("--denoise -1"));
     }
 }
