@@ -1,6 +1,6 @@
 //! What a real camera does to views and a rendered light field lacks, once for the robustness
 //! benchmark's corruptions (`lfeval`) and the trainer's augmentation (`lftrain`): the cos⁴
-//! vignetting falloff and JPEG compression. Both act per view in image coordinates, the same
+//! vignetting falloff and JPEG compression, and the benchmark's 8-bit sensor noise. Both act per view in image coordinates, the same
 //! in every view, so they are the same pixels' error in each view — not a shifted copy of the
 //! scene — and break the photo-consistency a depth estimator relies on.
 
@@ -10,6 +10,8 @@ use anyhow::{Context, Result};
 use image::RgbImage;
 use image::codecs::jpeg::JpegEncoder;
 use lfformat::srgb::{from_linear, to_linear};
+use rand::Rng;
+use rand_distr::{Distribution, StandardNormal};
 
 /// A lens' vignetting: linear light divided by `(1 + t² ρ²)²`, the cos⁴ law, `ρ` the distance
 /// from the optical centre over the image's half-diagonal and `t² = (1 − f)^-1/2 − 1` so that
@@ -72,6 +74,17 @@ impl Vignette {
     /// linear light.
     pub fn darken(v: f32, falloff: f32) -> f32 {
         from_linear(to_linear(v) / falloff)
+    }
+}
+
+/// Sensor noise as the robustness benchmark adds it: every 8-bit value of `img` plus Gaussian
+/// noise of standard deviation `sigma` levels from `rng` (one draw per value, in memory order),
+/// rounded and clipped.
+pub fn add_noise(img: &mut RgbImage, sigma: f64, rng: &mut impl Rng) {
+    for v in img.iter_mut() {
+        let z: f64 = StandardNormal.sample(rng);
+        let x = f32::from(*v) / 255.0 + (sigma * z) as f32 / 255.0;
+        *v = (x * 255.0).round().clamp(0.0, 255.0) as u8;
     }
 }
 

@@ -331,11 +331,10 @@ fn a_cost_volume_model_learns_sub_hypothesis_disparities() {
     }
 }
 
-/// Copies the scene folders of `data` to `out` with seeded Gaussian noise of standard
-/// deviation `sigma` added to every view (8-bit again, as a camera writes them).
-fn noisy_copy(data: &std::path::Path, out: &std::path::Path, sigma: f32) {
+/// Copies the scene folders of `data` to `out` with the robustness benchmark's noise of
+/// `sigma` 8-bit levels added to every view (seeded).
+fn noisy_copy(data: &std::path::Path, out: &std::path::Path, sigma: f64) {
     use rand::SeedableRng;
-    use rand_distr::{Distribution, StandardNormal};
     let mut rng = rand_pcg::Pcg64::seed_from_u64(11);
     for scene in std::fs::read_dir(data).unwrap() {
         let scene = scene.unwrap().path();
@@ -349,27 +348,21 @@ fn noisy_copy(data: &std::path::Path, out: &std::path::Path, sigma: f32) {
                 continue;
             }
             let mut img = image::open(&file).unwrap().to_rgb8();
-            for p in img.pixels_mut() {
-                for c in &mut p.0 {
-                    let z: f32 = StandardNormal.sample(&mut rng);
-                    *c = (f32::from(*c) + 255.0 * sigma * z)
-                        .round()
-                        .clamp(0.0, 255.0) as u8;
-                }
-            }
+            lfdata::camera::add_noise(&mut img, sigma, &mut rng);
             img.save(to.join(&name)).unwrap();
         }
     }
 }
 
-/// The shipped recipe's network kind on its training scenes with sensor noise σ = 0.03 added:
+/// The shipped recipe's network kind on its training scenes with sensor noise σ = 7.65/255
+/// (0.03) added:
 /// `lftrain predict` with test-time denoising (`--denoise 2`) comes closer to the true
 /// disparity than the single pass does.
 fn denoising_recovers_what_noise_took(o: &Overfit) {
     use lftrain::predict::{Overrides, predict_dataset_over};
     let (run, data) = (o.dir.path().join("run"), o.dir.path().join("train"));
     let noisy = o.dir.path().join("noisy");
-    noisy_copy(&data, &noisy, 0.03);
+    noisy_copy(&data, &noisy, 7.65);
     let mse = |denoise: f32| {
         let out = o.dir.path().join(format!("pred_denoise_{denoise}"));
         let with = Overrides {

@@ -4,9 +4,8 @@
 
 use anyhow::Result;
 use image::RgbImage;
-use lfdata::camera::{Vignette, jpeg_round_trip};
+use lfdata::camera::{Vignette, add_noise, jpeg_round_trip};
 use rand::Rng;
-use rand_distr::{Distribution, StandardNormal};
 use serde::Serialize;
 
 /// What a corruption does to a view.
@@ -89,10 +88,7 @@ impl Corruption {
     pub fn apply(&self, img: &mut RgbImage, pivot: f32, rng: &mut impl Rng) -> Result<()> {
         match *self {
             Corruption::Clean => {}
-            Corruption::Noise(sigma) => map_values(img, |v| {
-                let z: f64 = StandardNormal.sample(rng);
-                v + (sigma * z) as f32 / 255.0
-            }),
+            Corruption::Noise(sigma) => add_noise(img, sigma, rng),
             Corruption::Contrast(c) => map_values(img, |v| (v - pivot) * c as f32 + pivot),
             Corruption::Exposure(ev) => {
                 let gain = 2f32.powf(ev as f32);
