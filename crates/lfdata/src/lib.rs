@@ -8,9 +8,9 @@
 //! discretisation maths, [`posterior`] the predicted distributions, [`prediction`] (with
 //! [`npz`]) the prediction files, [`truth`] the ground truth (modes, front-most mode, masks);
 //! [`metrics`] the pure metric functions and [`scene_eval`] every metric of one method on one
-//! scene; [`camera`] what a real camera adds (vignetting, JPEG) for the robustness benchmark
-//! and the trainer's augmentation; [`progress`] and [`font`] the terminal's progress bar and
-//! the charts' font that the binaries share. Scene discovery and the file formats themselves are `lfformat`'s.
+//! scene; [`camera`] what a real camera adds (vignetting, JPEG, sensor noise) for the
+//! robustness benchmark and the trainer's augmentation; [`progress`] and [`font`] the
+//! terminal's progress bar and the charts' font that the binaries share. Scene discovery and the file formats themselves are `lfformat`'s.
 
 pub mod bins;
 pub mod camera;
