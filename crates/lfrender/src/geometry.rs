@@ -9,10 +9,9 @@ use super::wide::{Kernel, WideBvh};
 use crate::scene::shapes::MeshTri;
 use anyhow::{Result, bail};
 use glam::{Vec2, Vec3, Vec3A};
-use obvhs::{BvhBuildParams, cwbvh::builder::build_cwbvh, triangle::Triangle};
-use std::time::Duration;
+use obvhs::triangle::Triangle;
 
-/// Intersection data of one triangle, in BVH leaf order.
+/// Intersection data of one triangle.
 #[derive(Clone, Copy)]
 struct IsectTri {
     v0: Vec3A,
@@ -23,19 +22,17 @@ struct IsectTri {
     n: Vec3A,
 }
 
-/// Relative distance within which two hits on one object are one surface (shared edges,
-/// split leaves report the same crossing twice).
+/// Relative distance within which two hits on one object are one surface (two triangles
+/// meeting the ray at their shared edge report one crossing twice).
 const SAME_SURFACE: f32 = 1e-5;
 
-/// Shading data of one triangle, in BVH leaf order.
+/// Shading data of one triangle.
 #[derive(Clone, Copy, Debug)]
 pub struct TriShading {
     pub n: [Vec3; 3],
     pub uv: [Vec2; 3],
     pub material: u32,
     pub object: u32,
-    /// Index of the triangle before BVH reordering (spatial splits can duplicate leaves).
-    pub id: u32,
 }
 
 /// A ray–triangle intersection: distance and barycentrics of `v1`, `v2`.
@@ -58,9 +55,9 @@ pub struct Geometry {
     bvh: WideBvh,
     isect: Vec<IsectTri>,
     pub shading: Vec<TriShading>,
-    /// Opacity per leaf when uniform over the triangle, NaN when it comes from a texture: the
+    /// Opacity per triangle when uniform over it, NaN when it comes from a texture: the
     /// closest-hit test reads 4 bytes instead of the shading record and the material.
-    leaf_opacity: Vec<f32>,
+    tri_opacity: Vec<f32>,
 }
 
 impl Geometry {
@@ -86,36 +83,25 @@ impl Geometry {
                 Triangle { v0, v1, v2 }
             })
             .collect();
-        let bvh = build_cwbvh(
-            &build_boxes(&prims),
-            BvhBuildParams::medium_build(),
-            &mut Duration::default(),
-        );
-        let order = bvh.primitive_indices.iter().map(|&i| i as usize);
-        let isect: Vec<IsectTri> = order
-            .clone()
-            .map(|i| IsectTri {
-                v0: prims[i].v0,
-                e1: prims[i].v1 - prims[i].v0,
-                e2: prims[i].v2 - prims[i].v0,
-                n: (prims[i].v1 - prims[i].v0)
-                    .cross(prims[i].v2 - prims[i].v0)
-                    .normalize_or_zero(),
+        let edges: Vec<[Vec3A; 3]> = (prims.iter())
+            .map(|t| [t.v0, t.v1 - t.v0, t.v2 - t.v0])
+            .collect();
+        let bvh = WideBvh::new(&edges, &build_boxes(&prims), Kernel::from_env()?)?;
+        let isect: Vec<IsectTri> = (edges.iter())
+            .map(|&[v0, e1, e2]| {
+                let n = e1.cross(e2).normalize_or_zero();
+                IsectTri { v0, e1, e2, n }
             })
             .collect();
-        let shading: Vec<TriShading> = order
-            .map(|i| {
-                let t = &tris[i];
-                TriShading {
-                    n: t.tri.n,
-                    uv: t.tri.uv,
-                    material: t.material,
-                    object: t.object,
-                    id: i as u32,
-                }
+        let shading: Vec<TriShading> = (tris.iter())
+            .map(|t| TriShading {
+                n: t.tri.n,
+                uv: t.tri.uv,
+                material: t.material,
+                object: t.object,
             })
             .collect();
-        let leaf_opacity = shading
+        let tri_opacity = shading
             .iter()
             .map(|s| {
                 mats[s.material as usize]
@@ -123,12 +109,11 @@ impl Geometry {
                     .unwrap_or(f32::NAN)
             })
             .collect();
-        let edges: Vec<_> = isect.iter().map(|t| [t.v0, t.e1, t.e2]).collect();
         Ok(Self {
-            bvh: WideBvh::new(&bvh, &edges, Kernel::from_env()?)?,
+            bvh,
             isect,
             shading,
-            leaf_opacity,
+            tri_opacity,
         })
     }
 
@@ -187,11 +172,11 @@ impl Geometry {
             .unwrap_or_else(|| m.opacity.eval(self.uv(hit)))
     }
 
-    /// The opacity stochastic transparency tests a hit with (a leaf's uniform opacity where
-    /// it has one).
+    /// The opacity stochastic transparency tests a hit with (a triangle's uniform opacity
+    /// where it has one).
     #[inline]
     pub fn hit_opacity(&self, mats: &[RenderMaterial], hit: &Hit) -> f32 {
-        let uniform = self.leaf_opacity[hit.tri as usize];
+        let uniform = self.tri_opacity[hit.tri as usize];
         match uniform.is_nan() {
             true => self.opacity(mats, hit),
             false => uniform,
@@ -203,7 +188,7 @@ impl Geometry {
     #[inline]
     pub fn accepts(&self, mats: &[RenderMaterial], hit: &Hit, key: RayKey) -> bool {
         let a = self.hit_opacity(mats, hit);
-        a >= 1.0 || (a > 0.0 && key.uniform(self.shading[hit.tri as usize].id) < a)
+        a >= 1.0 || (a > 0.0 && key.uniform(hit.tri) < a)
     }
 
     /// Closest hit that passes the stochastic-transparency test for `key`.
@@ -246,7 +231,8 @@ impl Geometry {
     }
 
     /// Every surface along the ray up to `tmax`, sorted front to back, into `out` (cleared).
-    /// Duplicate reports of one surface (shared edges, split leaves) are removed.
+    /// Reports of one surface twice (two triangles of an object meeting the ray at a shared
+    /// edge) keep the first.
     pub fn all_hits(&self, origin: Vec3, dir: Vec3, tmax: f32, out: &mut Vec<Hit>) {
         out.clear();
         self.bvh.each_hit(origin.into(), dir.into(), tmax, |hit| {
@@ -256,7 +242,7 @@ impl Geometry {
         out.sort_unstable_by(|a, b| a.t.total_cmp(&b.t).then(a.tri.cmp(&b.tri)));
         out.dedup_by(|b, a| {
             let (sa, sb) = (&self.shading[a.tri as usize], &self.shading[b.tri as usize]);
-            sa.id == sb.id || (sa.object == sb.object && (b.t - a.t) <= SAME_SURFACE * a.t.max(1.0))
+            sa.object == sb.object && (b.t - a.t) <= SAME_SURFACE * a.t.max(1.0)
         });
     }
 

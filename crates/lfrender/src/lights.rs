@@ -17,7 +17,7 @@ use glam::{Vec2, Vec3};
 
 /// A sampled point on a light.
 pub struct LightSample {
-    /// The triangle (BVH order) the point lies on.
+    /// The triangle the point lies on.
     pub tri: u32,
     pub p: Vec3,
     pub n: Vec3,
@@ -53,20 +53,20 @@ impl Cluster {
     }
 }
 
-/// Object, original triangle index, BVH leaf and power of an emitting triangle.
-type EmittingLeaf = (u32, u32, u32, f32);
+/// Object, triangle and power of an emitting triangle.
+type Emitting = (u32, u32, f32);
 
 /// Emissive triangles grouped into clusters, sampled as the module describes.
 pub struct Lights {
     clusters: Vec<Cluster>,
-    /// Emissive triangles (BVH order), cluster after cluster.
+    /// Emissive triangles, cluster after cluster.
     tris: Vec<u32>,
     /// Per emissive triangle: cumulative probability within its cluster.
     cdf: Vec<f32>,
     /// Per emissive triangle: probability within its cluster, and its cluster.
     pmf: Vec<f32>,
     cluster: Vec<u32>,
-    /// Per triangle of the scene (BVH order): its index in `tris`, or [`NOT_EMISSIVE`].
+    /// Per triangle of the scene: its index in `tris`, or [`NOT_EMISSIVE`].
     slot: Vec<u32>,
 }
 
@@ -74,18 +74,18 @@ impl Lights {
     /// Collects the emitting triangles, one cluster per object (by object order past
     /// [`MAX_CLUSTERS`]).
     pub fn new(geo: &Geometry, mats: &[RenderMaterial]) -> Self {
-        let mut leaves: Vec<EmittingLeaf> = (0..geo.shading.len() as u32)
-            .filter_map(|leaf| {
-                let s = &geo.shading[leaf as usize];
+        let mut emitting: Vec<Emitting> = (0..geo.shading.len() as u32)
+            .filter_map(|tri| {
+                let s = &geo.shading[tri as usize];
                 let e = mats[s.material as usize]
                     .emission
                     .dot(Vec3::splat(1.0 / 3.0));
-                let power = area(&geo.vertices(leaf)) * e;
-                (power > 0.0).then_some((s.object, s.id, leaf, power))
+                let power = area(&geo.vertices(tri)) * e;
+                (power > 0.0).then_some((s.object, tri, power))
             })
             .collect();
-        leaves.sort_by_key(|&(object, id, leaf, _)| (object, id, leaf));
-        let objects: Vec<&[EmittingLeaf]> = leaves.chunk_by(|a, b| a.0 == b.0).collect();
+        emitting.sort_by_key(|&(object, tri, _)| (object, tri));
+        let objects: Vec<&[Emitting]> = emitting.chunk_by(|a, b| a.0 == b.0).collect();
         let mut lights = Self {
             clusters: Vec::new(),
             tris: Vec::new(),
@@ -100,25 +100,18 @@ impl Lights {
         lights
     }
 
-    /// Appends one cluster. A triangle that spatial splits left in several BVH leaves counts
-    /// once: each of its leaves maps to the first.
-    fn push_cluster<'a>(&mut self, geo: &Geometry, leaves: impl Iterator<Item = &'a EmittingLeaf>) {
+    /// Appends one cluster.
+    fn push_cluster<'a>(&mut self, geo: &Geometry, emitting: impl Iterator<Item = &'a Emitting>) {
         let index = self.clusters.len() as u32;
         let start = self.tris.len() as u32;
         let (mut lo, mut hi, mut power) = (Vec3::INFINITY, Vec3::NEG_INFINITY, 0.0);
-        let mut last_id = None;
-        for &(_, id, leaf, w) in leaves {
-            if last_id == Some(id) {
-                self.slot[leaf as usize] = self.tris.len() as u32 - 1;
-                continue;
-            }
-            last_id = Some(id);
-            for v in geo.vertices(leaf) {
+        for &(_, tri, w) in emitting {
+            for v in geo.vertices(tri) {
                 (lo, hi) = (lo.min(v), hi.max(v));
             }
             power += w;
-            self.slot[leaf as usize] = self.tris.len() as u32;
-            self.tris.push(leaf);
+            self.slot[tri as usize] = self.tris.len() as u32;
+            self.tris.push(tri);
             self.pmf.push(w);
             self.cluster.push(index);
         }
@@ -156,21 +149,27 @@ impl Lights {
 
     /// Picks a cluster for a shading point at `p` with `u` in [0, 1); returns it, its
     /// probability (as [`Self::cluster_probability`] computes it) and `u` rescaled to [0, 1)
-    /// within its share, for choosing the triangle.
+    /// within its share, for choosing the triangle. Each importance is computed once (a
+    /// division per cluster, up to [`MAX_CLUSTERS`] per light sample) and summed in the order
+    /// [`Self::total_importance`] sums it, so the probability is bit for bit the same.
     fn pick_cluster(&self, p: Vec3, u: f32) -> (&Cluster, f32, f32) {
         let [only] = &self.clusters[..] else {
-            let total = self.total_importance(p);
+            let mut weight = [0.0; MAX_CLUSTERS];
+            for (w, c) in weight.iter_mut().zip(&self.clusters) {
+                *w = c.importance(p);
+            }
+            let weight = &weight[..self.clusters.len()];
+            let total: f32 = weight.iter().sum();
             let mut rest = u * total;
-            for c in &self.clusters {
-                let w = c.importance(p);
+            for (c, &w) in self.clusters.iter().zip(weight) {
                 if rest < w {
                     return (c, w / total, (rest / w).min(ONE_BELOW));
                 }
                 rest -= w;
             }
             // Rounding left `u` past the last share.
-            let last = self.clusters.last().unwrap();
-            return (last, last.importance(p) / total, ONE_BELOW);
+            let (last, w) = (self.clusters.last().unwrap(), weight[weight.len() - 1]);
+            return (last, w / total, ONE_BELOW);
         };
         (only, 1.0, u)
     }

@@ -1,10 +1,10 @@
-//! The BVH the renderer traces: obvhs' compressed 8-wide tree rebuilt as a layout for CPU SIMD.
+//! The BVH the renderer traces: an 8-wide tree in a layout for CPU SIMD, collapsed from the
+//! binary tree obvhs builds (its PLOC build and reinsertion).
 //!
-//! obvhs builds the tree (its PLOC build and SAH collapse, and with them the order of the
-//! triangles, which every hit index refers to); its own traversal decodes 8-bit child boxes
-//! one at a time and tests leaf triangles one by one. Here each node keeps its eight child
-//! boxes as `f32` in structure-of-arrays form, so one SIMD pass tests all eight, and each leaf
-//! is one packet of up to four triangles in structure-of-arrays form, tested together.
+//! Each node keeps its eight child boxes as `f32` in structure-of-arrays form, so one SIMD
+//! pass tests all eight, and each leaf is one packet of up to four triangles in
+//! structure-of-arrays form, tested together (obvhs' own 8-wide traversal decodes 8-bit child
+//! boxes one at a time and tests leaf triangles one by one).
 //!
 //! Kernels: [`Kernel::Scalar`] (any target), [`Kernel::Sse`] (x86-64 baseline) and
 //! [`Kernel::Avx2`] (chosen at run time where the CPU has it) compute the same arithmetic lane
@@ -20,7 +20,7 @@ mod traverse;
 use super::geometry::Hit;
 use anyhow::{Result, bail};
 use glam::Vec3A;
-use obvhs::cwbvh::CwBvh;
+use obvhs::aabb::Aabb;
 
 /// Deepest tree the traversal's fixed stack holds: each level pushes at most seven entries.
 const MAX_DEPTH: usize = 64;
@@ -42,7 +42,7 @@ struct Node {
 struct Packet {
     /// `v0.x, v0.y, v0.z, e1.x, …, e2.z`, four lanes each.
     coords: [[f32; 4]; 9],
-    /// Triangle index (BVH leaf order) per lane.
+    /// Triangle index (the caller's) per lane.
     tri: [u32; 4],
 }
 
@@ -143,13 +143,14 @@ pub struct WideBvh {
 }
 
 impl WideBvh {
-    /// Rebuilds obvhs' tree over `tris` (`v0, e1, e2` per triangle, in the tree's leaf order)
-    /// with exact `f32` boxes. Fails on a tree deeper than the traversal stack holds.
-    pub fn new(cw: &CwBvh, tris: &[[Vec3A; 3]], kernel: Kernel) -> Result<Self> {
-        let (nodes, packets) = build::collapse(cw, tris)?;
+    /// Builds the tree over `tris` (`v0, e1 = v1 − v0, e2 = v2 − v0` per triangle), its
+    /// binary tree over `boxes` (one per triangle, containing it). Hits name triangles by their
+    /// index in `tris`. Fails on a tree deeper than the traversal stack holds.
+    pub fn new(tris: &[[Vec3A; 3]], boxes: &[Aabb], kernel: Kernel) -> Result<Self> {
+        let built = build::build(tris, boxes)?;
         Ok(Self {
-            nodes,
-            packets,
+            nodes: built.nodes,
+            packets: built.packets,
             kernel,
         })
     }
@@ -159,8 +160,8 @@ impl WideBvh {
     }
 
     /// Closest hit in `(tmin, tmax]` that `accept` keeps; among hits at one distance, the
-    /// lowest triangle index: a total order, so the answer does not depend on the order the
-    /// tree is walked in.
+    /// lowest triangle index: a total order, so the answer depends neither on the order the
+    /// tree is walked in nor on the tree.
     pub fn closest(
         &self,
         origin: Vec3A,

@@ -2,8 +2,7 @@
 
 use super::*;
 use glam::Vec2;
-use obvhs::{BvhBuildParams, cwbvh::builder::build_cwbvh, triangle::Triangle};
-use std::time::Duration;
+use obvhs::triangle::Triangle;
 
 /// xorshift32: a fixed stream of test numbers without a dependency.
 struct Rng(u32);
@@ -128,23 +127,17 @@ fn brute(tris: &[[Vec3A; 3]], o: Vec3A, d: Vec3A, tmin: f32, tmax: f32) -> Vec<H
     hits
 }
 
-/// The tree of `tris` in each kernel, built as the renderer builds it (obvhs over
-/// `build_boxes`), and its triangles (`v0, e1, e2`) in leaf order.
+/// The tree of `tris` in each kernel, built as the renderer builds it (over `build_boxes`),
+/// and its triangles as `v0, e1, e2`.
 fn trees_of(tris: &[Triangle]) -> (Vec<WideBvh>, Vec<[Vec3A; 3]>) {
     let boxes = super::super::build_boxes::build_boxes(tris);
-    let cw = build_cwbvh(
-        &boxes,
-        BvhBuildParams::medium_build(),
-        &mut Duration::default(),
-    );
-    let leaf: Vec<[Vec3A; 3]> = (cw.primitive_indices.iter())
-        .map(|&i| tris[i as usize])
+    let edges: Vec<[Vec3A; 3]> = (tris.iter())
         .map(|t| [t.v0, t.v1 - t.v0, t.v2 - t.v0])
         .collect();
     let trees = (Kernel::available().into_iter())
-        .map(|k| WideBvh::new(&cw, &leaf, k).unwrap())
+        .map(|k| WideBvh::new(&edges, &boxes, k).unwrap())
         .collect();
-    (trees, leaf)
+    (trees, edges)
 }
 
 /// The soup's trees ([`trees_of`]).
