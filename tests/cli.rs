@@ -110,12 +110,17 @@ fn gt_spp_changes_the_ground_truth_and_not_the_views() {
     }
 }
 
-/// `render.final_gather` through the CLI: a second fill pass changes the views' light but not
-/// the ground truth (the GT comes from the camera streams alone), and it stays deterministic
-/// across thread counts (the gathered sums merge in the same fixed order as the fill's).
+/// `render.final_gather` (on by default) through the CLI: the second fill pass changes the
+/// views' light but not the ground truth (the GT comes from the camera streams alone), and it
+/// stays deterministic across thread counts (the gathered sums merge in the same fixed order as
+/// the fill's).
 #[test]
 fn a_final_gather_changes_the_views_not_the_ground_truth_and_stays_deterministic() {
-    let [fa, fb, fc] = one_scene_without_and_with(&["--set", "render.final_gather=true"]);
+    let (with, without, one_thread) = (tmp(), tmp(), tmp());
+    ok(generate(with.path(), "1", &[]));
+    ok(generate(without.path(), "1", &["--preset", "fast"]));
+    ok(generate(one_thread.path(), "1", &["--threads", "1"]));
+    let [fb, fa, fc] = [&with, &without, &one_thread].map(|d| files(d.path()));
     let scene = "train/scene_0000/";
     let view = format!("{scene}input_Cam004.png");
     assert!(fa[&view] != fb[&view], "the gather left {view} unchanged");
@@ -679,7 +684,7 @@ fn the_help_lists_commands_and_completions_and_man_page_are_generated() {
         "a help text names an issue"
     );
     let bash = String::from_utf8(ok(lfgen(&["completions", "bash"], &[])).stdout).unwrap();
-    assert!(bash.contains("quick wide clean") && bash.contains("pov blender mitsuba"));
+    assert!(bash.contains("quick fast wide clean") && bash.contains("pov blender mitsuba"));
     let man = String::from_utf8(ok(lfgen(&["man"], &[])).stdout).unwrap();
     assert!(man.contains(".TH lfgen 1"), "{man}");
 }
