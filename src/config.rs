@@ -216,9 +216,9 @@ pub struct RenderConfig {
     pub cache_shrink: bool,
     /// Shared shading: a second fill pass whose paths read the first pass's cache at their
     /// second surface (a final gather), its estimates added to the cells' (see
-    /// `render::integrator::Shading::Gather`): +0.9 dB for 1.15x the scene time at 512²;
-    /// `--preset fast` (and `quick`) turn it off; with `cache_spp = 2` (`--preset clean`)
-    /// 40 dB.
+    /// `render::integrator::Shading::Gather`): +0.1–0.9 dB for 1.15x the scene time at 512²;
+    /// `--preset fast` (and `quick`) turn it off; `--preset clean` adds `cache_spp = 2` for
+    /// 1.4x.
     pub final_gather: bool,
     /// Average library textures seen by camera rays over one sample's footprint.
     pub texture_filter: bool,
@@ -309,7 +309,7 @@ pub const PRESETS: &[Preset] = &[
     },
     Preset {
         name: "fast",
-        about: "the defaults without the final gather: 0.87× the time, views 0.9 dB noisier",
+        about: "the defaults without the final gather: 0.87× the time, views 0.1–0.9 dB noisier",
         sets: &["render.final_gather=false"],
     },
     Preset {
@@ -319,7 +319,7 @@ pub const PRESETS: &[Preset] = &[
     },
     Preset {
         name: "clean",
-        about: "views at about 40 dB for 1.4× the time (2 fill spp beside the final gather)",
+        about: "the least noisy views: 2 fill spp beside the final gather, 1.4× the time",
         sets: &["render.final_gather=true", "render.cache_spp=2"],
     },
     Preset {
