@@ -116,20 +116,30 @@ fn gt_spp_changes_the_ground_truth_and_not_the_views() {
 /// the fill's).
 #[test]
 fn a_final_gather_changes_the_views_not_the_ground_truth_and_stays_deterministic() {
-    let (with, without, one_thread) = (tmp(), tmp(), tmp());
-    ok(generate(with.path(), "1", &[]));
-    ok(generate(without.path(), "1", &["--preset", "fast"]));
-    ok(generate(one_thread.path(), "1", &["--threads", "1"]));
-    let [fb, fa, fc] = [&with, &without, &one_thread].map(|d| files(d.path()));
+    let runs: [&[&str]; 3] = [&[], &["--preset", "fast"], &["--threads", "1"]];
+    let [gathered, plain, one_thread] = runs.map(|args| {
+        let d = tmp();
+        ok(generate(d.path(), "1", args));
+        files(d.path())
+    });
     let scene = "train/scene_0000/";
     let view = format!("{scene}input_Cam004.png");
-    assert!(fa[&view] != fb[&view], "the gather left {view} unchanged");
+    assert!(
+        plain[&view] != gathered[&view],
+        "the gather left {view} unchanged"
+    );
     for gt in ["modes.exr", "gt_disp_lowres.pfm"] {
         let name = format!("{scene}{gt}");
-        assert!(fa[&name] == fb[&name], "{name} changed with the gather");
+        assert!(
+            plain[&name] == gathered[&name],
+            "{name} changed with the gather"
+        );
     }
-    for (name, bytes) in &fb {
-        assert!(bytes == &fc[name], "{name} differs between thread counts");
+    for (name, bytes) in &gathered {
+        assert!(
+            bytes == &one_thread[name],
+            "{name} differs between thread counts"
+        );
     }
 }
 
